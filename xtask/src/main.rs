@@ -1,1 +1,69 @@
-fn main() {}
+//! `cargo xtask`: project automation in Rust (matklad/cargo-xtask; style anchor B2.6).
+//!
+//! xtask links no renderer crate. It builds the `photonflow` binary once, in release, through
+//! `$CARGO` and runs it, so a change to xtask never rebuilds the renderer and vice versa.
+
+mod flags;
+mod gen_scenes;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match run(&args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("xtask: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(args: &[String]) -> Result<(), String> {
+    let cmd = flags::parse(args)?;
+    match cmd {
+        flags::Cmd::Help => {
+            print!("{}", flags::HELP);
+            Ok(())
+        }
+        flags::Cmd::GenScenes => gen_scenes::run(&project_root()),
+        flags::Cmd::Photonflow(args) => photonflow(&args),
+    }
+}
+
+/// The workspace root, from this crate's manifest directory.
+pub fn project_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask sits one level below the root")
+        .to_path_buf()
+}
+
+/// Build the release `photonflow` binary and run it with `args` from the project root.
+fn photonflow(args: &[String]) -> Result<(), String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let root = project_root();
+    let status = Command::new(&cargo)
+        .current_dir(&root)
+        .args(["build", "--quiet", "--release", "--package", "photonflow"])
+        .status()
+        .map_err(|e| format!("cannot run {cargo}: {e}"))?;
+    if !status.success() {
+        return Err("building photonflow failed".into());
+    }
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root.join("target"));
+    let exe = target.join("release").join(format!("photonflow{}", std::env::consts::EXE_SUFFIX));
+    let status = Command::new(&exe)
+        .current_dir(&root)
+        .args(args)
+        .status()
+        .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("photonflow {} failed ({status})", args.join(" ")))
+    }
+}

@@ -1,0 +1,58 @@
+use glam::Vec3;
+
+/// Axis-aligned bounding box. `EMPTY` is the identity of [`Bounds3::union`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds3 {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Bounds3 {
+    pub const EMPTY: Bounds3 = Bounds3 {
+        min: Vec3::splat(f32::INFINITY),
+        max: Vec3::splat(f32::NEG_INFINITY),
+    };
+
+    pub fn from_point(p: Vec3) -> Bounds3 {
+        Bounds3 { min: p, max: p }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.min.cmpgt(self.max).any()
+    }
+
+    pub fn union_point(self, p: Vec3) -> Bounds3 {
+        Bounds3 {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
+    }
+
+    pub fn union(self, b: Bounds3) -> Bounds3 {
+        Bounds3 {
+            min: self.min.min(b.min),
+            max: self.max.max(b.max),
+        }
+    }
+
+    pub fn diagonal(&self) -> Vec3 {
+        if self.is_empty() {
+            Vec3::ZERO
+        } else {
+            self.max - self.min
+        }
+    }
+
+    pub fn centroid(&self) -> Vec3 {
+        0.5 * (self.min + self.max)
+    }
+
+    pub fn contains(&self, p: Vec3) -> bool {
+        p.cmpge(self.min).all() && p.cmple(self.max).all()
+    }
+
+    /// Point at fractional coordinates `t` in `[0,1]^3` (for sampling inside the box).
+    pub fn lerp(&self, t: Vec3) -> Vec3 {
+        self.min + t * (self.max - self.min)
+    }
+}

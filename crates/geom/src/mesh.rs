@@ -1,0 +1,105 @@
+use crate::Bounds3;
+use glam::Vec3;
+
+/// All triangles of a scene in world space, in one indexed mesh.
+#[derive(Clone, Debug, Default)]
+pub struct TriMesh {
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals: empty (flat shading) or one per position.
+    pub normals: Vec<Vec3>,
+    pub indices: Vec<[u32; 3]>,
+    /// Material id of each triangle.
+    pub materials: Vec<u32>,
+}
+
+impl TriMesh {
+    pub fn len(&self) -> usize {
+        self.indices.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.indices.is_empty()
+    }
+
+    pub fn vertices(&self, tri: usize) -> [Vec3; 3] {
+        let [a, b, c] = self.indices[tri];
+        [
+            self.positions[a as usize],
+            self.positions[b as usize],
+            self.positions[c as usize],
+        ]
+    }
+
+    /// Unnormalised geometric normal `(p1 - p0) x (p2 - p0)`: its length is twice the area.
+    pub fn face_normal(&self, tri: usize) -> Vec3 {
+        let [p0, p1, p2] = self.vertices(tri);
+        (p1 - p0).cross(p2 - p0)
+    }
+
+    pub fn area(&self, tri: usize) -> f32 {
+        // f64 cross product: light areas feed the power table, and thin slivers lose digits.
+        let [p0, p1, p2] = self.vertices(tri).map(|p| p.as_dvec3());
+        0.5 * (p1 - p0).cross(p2 - p0).length() as f32
+    }
+
+    pub fn bounds(&self) -> Bounds3 {
+        self.positions
+            .iter()
+            .fold(Bounds3::EMPTY, |b, &p| b.union_point(p))
+    }
+
+    /// Append another mesh, shifting its indices. Normals stay per-vertex: a flat mesh joined
+    /// to a smooth one gets its face normals as vertex normals only if needed, so we keep a
+    /// flag per triangle instead (see `Geometry`). Here: fill missing normals with zero,
+    /// which `Geometry` reads as "use the face normal".
+    pub fn append(&mut self, other: &TriMesh) {
+        let base = self.positions.len() as u32;
+        let self_has = !self.normals.is_empty();
+        let other_has = !other.normals.is_empty();
+        if self_has || other_has {
+            if !self_has {
+                self.normals = vec![Vec3::ZERO; self.positions.len()];
+            }
+            if other_has {
+                self.normals.extend_from_slice(&other.normals);
+            } else {
+                self.normals
+                    .extend(std::iter::repeat_n(Vec3::ZERO, other.positions.len()));
+            }
+        }
+        self.positions.extend_from_slice(&other.positions);
+        self.indices.extend(
+            other
+                .indices
+                .iter()
+                .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
+        );
+        self.materials.extend_from_slice(&other.materials);
+    }
+}
+
+/// Angle-weighted vertex normals (Thürmer & Wüthrich 1998, "Computing vertex normals from
+/// polygonal facets"): each face adds its unit normal times the corner angle, so normals do
+/// not depend on how a surface is split into triangles. The course's sphere meshes carry no
+/// normals and get theirs this way at load. Degenerate faces add nothing.
+pub fn smooth_vertex_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut acc = vec![glam::DVec3::ZERO; positions.len()];
+    for tri in indices {
+        let p = tri.map(|i| positions[i as usize].as_dvec3());
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        let len = n.length();
+        if len == 0.0 || !len.is_finite() {
+            continue;
+        }
+        let n = n / len;
+        for k in 0..3 {
+            let e1 = (p[(k + 1) % 3] - p[k]).normalize_or_zero();
+            let e2 = (p[(k + 2) % 3] - p[k]).normalize_or_zero();
+            let angle = e1.dot(e2).clamp(-1.0, 1.0).acos();
+            acc[tri[k] as usize] += angle * n;
+        }
+    }
+    acc.into_iter()
+        .map(|n| n.normalize_or_zero().as_vec3())
+        .collect()
+}

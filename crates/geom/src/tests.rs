@@ -1,0 +1,379 @@
+//! Tests of `geom` against independent references: f64 Cramer's-rule triangles, f64
+//! geometric spheres, and brute force over all primitives.
+
+use crate::{BvhKind, Geometry, Prim, Ray, Sphere, SurfacePoint, TriMesh, smooth_vertex_normals};
+use glam::{DVec3, Vec3};
+use math::Rng;
+
+fn rand_vec(rng: &mut Rng, lo: f32, hi: f32) -> Vec3 {
+    Vec3::new(
+        lo + (hi - lo) * rng.uniform(),
+        lo + (hi - lo) * rng.uniform(),
+        lo + (hi - lo) * rng.uniform(),
+    )
+}
+
+fn rand_dir(rng: &mut Rng) -> Vec3 {
+    // Uniform on the sphere (Archimedes): z uniform, phi uniform.
+    let z = 1.0 - 2.0 * rng.uniform();
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = std::f32::consts::TAU * rng.uniform();
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// UV sphere: `slices` around, `stacks` from pole to pole, outward winding.
+fn uv_sphere(c: Vec3, r: f32, slices: u32, stacks: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let mut pos = vec![c + Vec3::Y * r];
+    for i in 1..stacks {
+        let th = std::f32::consts::PI * i as f32 / stacks as f32;
+        for j in 0..slices {
+            let ph = std::f32::consts::TAU * j as f32 / slices as f32;
+            pos.push(c + r * Vec3::new(th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin()));
+        }
+    }
+    pos.push(c - Vec3::Y * r);
+    let south = pos.len() as u32 - 1;
+    let ring = |i: u32, j: u32| 1 + (i - 1) * slices + (j % slices);
+    let mut idx = Vec::new();
+    for j in 0..slices {
+        idx.push([0, ring(1, j + 1), ring(1, j)]);
+        idx.push([south, ring(stacks - 1, j), ring(stacks - 1, j + 1)]);
+    }
+    for i in 1..stacks - 1 {
+        for j in 0..slices {
+            let (a, b, cc, d) = (ring(i, j), ring(i, j + 1), ring(i + 1, j + 1), ring(i + 1, j));
+            idx.push([a, b, cc]);
+            idx.push([a, cc, d]);
+        }
+    }
+    (pos, idx)
+}
+
+fn mesh_of(parts: &[(Vec<Vec3>, Vec<[u32; 3]>)]) -> TriMesh {
+    let mut m = TriMesh::default();
+    for (mat, (p, i)) in parts.iter().enumerate() {
+        m.append(&TriMesh {
+            positions: p.clone(),
+            normals: vec![],
+            indices: i.clone(),
+            materials: vec![mat as u32; i.len()],
+        });
+    }
+    m
+}
+
+/// Axis-aligned-ish quad as two triangles.
+fn quad(a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    (vec![a, b, c, d], vec![[0, 1, 2], [0, 2, 3]])
+}
+
+/// Reference ray–triangle: Cramer's rule on o + t d = p0 + b1 e1 + b2 e2 in f64.
+fn ref_triangle(o: DVec3, d: DVec3, p: [DVec3; 3]) -> Option<(f64, f64, f64)> {
+    ref_triangle_slack(o, d, p, 0.0)
+}
+
+/// As `ref_triangle`, with the triangle grown by `slack` in barycentric terms (edge hits).
+fn ref_triangle_slack(o: DVec3, d: DVec3, p: [DVec3; 3], slack: f64) -> Option<(f64, f64, f64)> {
+    let e1 = p[1] - p[0];
+    let e2 = p[2] - p[0];
+    let s = o - p[0];
+    let det = (-d).dot(e1.cross(e2));
+    if det.abs() < 1e-300 {
+        return None;
+    }
+    let t = s.dot(e1.cross(e2)) / det;
+    let b1 = (-d).dot(s.cross(e2)) / det;
+    let b2 = (-d).dot(e1.cross(s)) / det;
+    (t > 0.0 && b1 >= -slack && b2 >= -slack && b1 + b2 <= 1.0 + slack).then_some((t, b1, b2))
+}
+
+#[test]
+fn triangle_hits_agree_with_f64_cramer_reference() {
+    let mut rng = Rng::new(11);
+    let (mut hits, mut near_edge) = (0, 0);
+    for k in 0..20_000 {
+        let p = [0; 3].map(|_| rand_vec(&mut rng, -1.0, 1.0));
+        let geo = Geometry::new(mesh_of(&[(p.to_vec(), vec![[0, 1, 2]])]), vec![]);
+        let _ = k;
+        let o = rand_vec(&mut rng, -3.0, 3.0);
+        // Aim at a random point near the triangle so about half the rays hit.
+        let target = p[0] + (p[1] - p[0]) * 1.4 * rng.uniform() + (p[2] - p[0]) * 1.4 * rng.uniform();
+        let ray = Ray::new(o, target - o);
+        let reference = ref_triangle(o.as_dvec3(), ray.d.as_dvec3(), p.map(|v| v.as_dvec3()));
+        let got = geo.intersect(&ray);
+        match (reference, got) {
+            (Some((t, b1, b2)), Some(h)) => {
+                hits += 1;
+                assert!(((h.t as f64 - t) / t).abs() < 1e-4, "t {} vs {t}", h.t);
+                assert!((h.uv[0] as f64 - b1).abs() < 1e-3 && (h.uv[1] as f64 - b2).abs() < 1e-3);
+                let pref = o.as_dvec3() + t * ray.d.as_dvec3();
+                assert!((h.point.p.as_dvec3() - pref).length() < 1e-4 * (1.0 + pref.length()));
+            }
+            (None, None) => {}
+            (a, b) => {
+                // Disagreement is allowed only for rays grazing an edge.
+                let (b1, b2) = match (a, b) {
+                    (Some((_, b1, b2)), _) => (b1, b2),
+                    (_, Some(h)) => (h.uv[0] as f64, h.uv[1] as f64),
+                    _ => unreachable!(),
+                };
+                let m = b1.abs().min(b2.abs()).min((1.0 - b1 - b2).abs());
+                assert!(m < 1e-4, "disagreement away from an edge: b = ({b1}, {b2})");
+                near_edge += 1;
+            }
+        }
+    }
+    assert!(hits > 5_000, "too few hits ({hits}) for the test to mean anything");
+    assert!(near_edge < 20, "{near_edge} edge disagreements");
+}
+
+/// Reference ray–sphere: closest approach of the line to the centre, in f64.
+fn ref_sphere(o: DVec3, d: DVec3, c: DVec3, r: f64) -> Option<f64> {
+    let dn = d.normalize();
+    let tc = (c - o).dot(dn);
+    let h2 = (c - o).length_squared() - tc * tc;
+    if h2 > r * r {
+        return None;
+    }
+    let dt = (r * r - h2).sqrt();
+    let (t0, t1) = (tc - dt, tc + dt);
+    let t = if t0 > 0.0 { t0 } else { t1 };
+    (t > 0.0).then_some(t / d.length())
+}
+
+#[test]
+fn sphere_hits_agree_with_geometric_reference() {
+    let mut rng = Rng::new(12);
+    let mut hits = 0;
+    for _ in 0..20_000 {
+        let c = rand_vec(&mut rng, -5.0, 5.0);
+        let r = 0.1 + 2.0 * rng.uniform();
+        let geo = Geometry::new(TriMesh::default(), vec![Sphere { center: c, radius: r, material: 7 }]);
+        // Origins inside and outside; directions aimed near the sphere.
+        let o = c + rand_dir(&mut rng) * r * 3.0 * rng.uniform();
+        let d = (c + rand_dir(&mut rng) * r * 1.2 - o) * (0.5 + rng.uniform());
+        let reference = ref_sphere(o.as_dvec3(), d.as_dvec3(), c.as_dvec3(), r as f64);
+        let got = geo.intersect(&Ray::new(o, d));
+        match (reference, got) {
+            (Some(t), Some(h)) => {
+                hits += 1;
+                assert!(((h.t as f64 - t) / t).abs() < 1e-5, "t {} vs {t}", h.t);
+                assert_eq!(h.material, 7);
+                assert!(((h.point.p - c).length() - r).abs() <= 1e-5 * (r + c.length()));
+                assert!((h.point.n - (h.point.p - c) / r).length() < 1e-4);
+            }
+            (None, None) => {}
+            (a, b) => {
+                // Only tangent rays may disagree.
+                let dn = d.normalize().as_dvec3();
+                let oc = c.as_dvec3() - o.as_dvec3();
+                let h = (oc - oc.dot(dn) * dn).length();
+                assert!((h - r as f64).abs() < 1e-5 * r as f64, "{a:?} vs {:?}", b.map(|h| h.t));
+            }
+        }
+    }
+    assert!(hits > 10_000);
+}
+
+/// A scene with everything: a tessellated sphere, walls, random triangles and two spheres.
+fn test_scene(kind: BvhKind) -> Geometry {
+    let mut rng = Rng::new(5);
+    let mut parts = vec![uv_sphere(Vec3::new(1.0, 2.0, 3.0), 1.5, 48, 24)];
+    parts.push(quad(
+        Vec3::new(-5.0, 0.0, -5.0),
+        Vec3::new(-5.0, 0.0, 5.0),
+        Vec3::new(5.0, 0.0, 5.0),
+        Vec3::new(5.0, 0.0, -5.0),
+    ));
+    let soup: Vec<Vec3> = (0..3 * 2000)
+        .map(|_| rand_vec(&mut rng, -5.0, 5.0))
+        .collect();
+    let soup: Vec<Vec3> = soup
+        .chunks(3)
+        .flat_map(|t| {
+            let c = t[0];
+            [c, c + (t[1] - c) * 0.1, c + (t[2] - c) * 0.1]
+        })
+        .collect();
+    let idx = (0..2000u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+    parts.push((soup, idx));
+    let spheres = vec![
+        Sphere { center: Vec3::new(-2.0, 1.0, 0.0), radius: 1.0, material: 10 },
+        Sphere { center: Vec3::new(2.5, -1.0, -2.0), radius: 0.7, material: 11 },
+    ];
+    Geometry::with_bvh(mesh_of(&parts), spheres, kind)
+}
+
+#[test]
+fn bvh_closest_hits_equal_brute_force() {
+    for kind in [BvhKind::CwBvh, BvhKind::Bvh2] {
+        let geo = test_scene(kind);
+        let mut rng = Rng::new(99);
+        let mut hits = 0;
+        for _ in 0..5_000 {
+            let ray = Ray::new(rand_vec(&mut rng, -6.0, 6.0), rand_dir(&mut rng));
+            let a = geo.intersect(&ray);
+            let b = geo.intersect_brute_force(&ray);
+            match (a, b) {
+                (Some(a), Some(b)) => {
+                    hits += 1;
+                    assert_eq!(a.t, b.t, "{kind:?}");
+                    // Equal t on two primitives happens only on shared edges.
+                    if a.prim != b.prim {
+                        assert!(a.uv.iter().chain(&b.uv).any(|x| *x < 1e-5 || *x > 1.0 - 1e-5));
+                    }
+                }
+                (None, None) => {}
+                (a, b) => panic!("{kind:?}: bvh {:?} vs brute {:?}", a.map(|h| h.t), b.map(|h| h.t)),
+            }
+            // Shadow queries agree with the closest hit.
+            let seg = Ray { t_max: 3.0, ..ray };
+            assert_eq!(geo.occluded(&seg), geo.intersect_brute_force(&seg).is_some());
+        }
+        assert!(hits > 1_000, "{kind:?}: {hits} hits");
+    }
+}
+
+#[test]
+fn spawned_rays_never_rehit_their_surface_at_any_scale() {
+    // Scene scales 1e-3 .. 1e4, also translated far from the origin: every spawned ray either
+    // escapes (planes, convex spheres seen from outside) or hits the far side of a sphere at a
+    // distance comparable to its size, never its own surface near t = 0.
+    let mut rng = Rng::new(3);
+    for exp in -3..=4 {
+        let s = 10f32.powi(exp);
+        let off = Vec3::new(3.7, -1.3, 2.1) * s;
+        let (sp, si) = uv_sphere(off + Vec3::new(2.0, 0.0, 0.0) * s, s, 32, 16);
+        let tilted = quad(
+            off + Vec3::new(-1.0, -0.3, -1.0) * s,
+            off + Vec3::new(-1.0, 0.2, 1.0) * s,
+            off + Vec3::new(0.0, 0.4, 1.0) * s,
+            off + Vec3::new(0.0, -0.1, -1.0) * s,
+        );
+        let geo = Geometry::new(
+            mesh_of(&[(sp, si), tilted]),
+            vec![Sphere { center: off + Vec3::new(-3.0, 0.0, 0.0) * s, radius: s, material: 9 }],
+        );
+        for target in [Vec3::new(2.0, 0.0, 0.0), Vec3::new(-0.5, 0.0, 0.0), Vec3::new(-3.0, 0.0, 0.0)] {
+            for _ in 0..200 {
+                let o = off + (target + rand_dir(&mut rng) * 3.0) * s;
+                let aim = off + (target + rand_dir(&mut rng) * 0.5) * s;
+                let Some(h) = geo.intersect(&Ray::new(o, aim - o)) else { continue };
+                for _ in 0..50 {
+                    let w = rand_dir(&mut rng);
+                    let r = h.point.spawn_ray(w);
+                    if let Some(h2) = geo.intersect(&r) {
+                        // One material per surface here: the tessellated sphere, the quad,
+                        // the analytic sphere.
+                        let outward = w.dot(h.point.n) > 0.0;
+                        // Every hit must be real: confirmed by the f64 references from the
+                        // spawned origin, at the same distance. A false self-hit at t ~ 0 is
+                        // not, because in exact arithmetic the origin is off the surface.
+                        let (o64, d64) = (r.o.as_dvec3(), r.d.as_dvec3());
+                        let t_ref = match h2.prim {
+                            Prim::Triangle(id) => {
+                                let v = geo.mesh().vertices(id as usize).map(|p| p.as_dvec3());
+                                ref_triangle_slack(o64, d64, v, 1e-5).map(|x| x.0)
+                            }
+                            Prim::Sphere(k) => {
+                                let sp = geo.spheres()[k as usize];
+                                ref_sphere(o64, d64, sp.center.as_dvec3(), sp.radius as f64)
+                            }
+                        };
+                        let confirmed = t_ref.is_some_and(|t| {
+                            (t - h2.t as f64).abs() <= 1e-4 * t + 1e-6 * r.o.length() as f64
+                        });
+                        // Leaving a convex surface outwards never meets it again.
+                        let ok = confirmed && !(outward && h2.material == h.material);
+                        assert!(
+                            ok,
+                            "scale {s}: re-hit {:?} at t = {} from {:?}",
+                            h2.prim,
+                            h2.t,
+                            h.prim
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn light_under_the_ceiling_is_reachable_from_the_floor_and_not_through_the_ceiling() {
+    // The worksheet's light sits 0.0025 units under the ceiling (scene-facts.md).
+    let y_c = 13.72;
+    let y_l = 13.7175;
+    let ceiling = quad(
+        Vec3::new(-13.9, y_c, 0.0),
+        Vec3::new(-13.9, y_c, -13.98),
+        Vec3::new(0.0, y_c, -13.98),
+        Vec3::new(0.0, y_c, 0.0),
+    );
+    // Light winding gives a downward normal.
+    let light = quad(
+        Vec3::new(-8.575, y_l, -5.675),
+        Vec3::new(-8.575, y_l, -8.3),
+        Vec3::new(-5.325, y_l, -8.3),
+        Vec3::new(-5.325, y_l, -5.675),
+    );
+    let floor = quad(
+        Vec3::new(-13.82, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, -13.98),
+        Vec3::new(-13.74, 0.0, -13.98),
+    );
+    let geo = Geometry::new(mesh_of(&[ceiling, light, floor]), vec![]);
+    let light_id = |p: Prim| matches!(p, Prim::Triangle(2) | Prim::Triangle(3));
+    let mut rng = Rng::new(8);
+    for _ in 0..2_000 {
+        let lp = Vec3::new(-8.575 + 3.25 * rng.uniform(), y_l, -8.3 + 2.625 * rng.uniform());
+        // Find the light point by a ray from below, as a path tracer would.
+        let fp = Vec3::new(-13.0 + 12.0 * rng.uniform(), 0.0, -13.0 + 12.0 * rng.uniform());
+        let down = geo.intersect(&Ray::new(fp + Vec3::Y, Vec3::NEG_Y)).unwrap();
+        assert!(matches!(down.prim, Prim::Triangle(4) | Prim::Triangle(5)));
+        let up = geo.intersect(&down.point.spawn_ray(lp - down.point.p)).unwrap();
+        assert!(light_id(up.prim), "floor ray to the light hit {:?}", up.prim);
+        // Shadow ray between the two surface points is clear.
+        assert!(!geo.occluded(&down.point.spawn_ray_to_point(&up.point)));
+        // From the light's back side upwards: the ceiling, 0.0025 away, not the sky.
+        let back = geo.intersect(&up.point.spawn_ray(Vec3::Y)).unwrap();
+        assert!(matches!(back.prim, Prim::Triangle(0) | Prim::Triangle(1)));
+        assert!((back.t - 0.0025).abs() < 1e-4, "t = {}", back.t);
+        // From the ceiling's underside downwards: the light first.
+        let c = geo.intersect(&back.point.spawn_ray(Vec3::NEG_Y)).unwrap();
+        assert!(light_id(c.prim) && (c.t - 0.0025).abs() < 1e-4);
+        // From above the ceiling the light is hidden.
+        let above = lp + Vec3::Y * 5.0;
+        let blocked = SurfacePoint { p: above, p_err: Vec3::ZERO, n: Vec3::Y }.spawn_ray_to(lp);
+        assert!(geo.occluded(&blocked));
+    }
+}
+
+#[test]
+fn smooth_normals_of_a_uv_sphere_are_radial() {
+    let c = Vec3::new(0.5, -1.0, 2.0);
+    let (p, i) = uv_sphere(c, 2.0, 64, 32);
+    let n = smooth_vertex_normals(&p, &i);
+    for (v, nv) in p.iter().zip(&n) {
+        let radial = (*v - c).normalize();
+        assert!(nv.dot(radial) > 0.9999, "{nv:?} vs {radial:?}");
+    }
+}
+
+#[test]
+fn shading_normals_interpolate_and_face_the_same_side() {
+    let c = Vec3::ZERO;
+    let (p, i) = uv_sphere(c, 1.0, 32, 16);
+    let n = smooth_vertex_normals(&p, &i);
+    let m = TriMesh { materials: vec![0; i.len()], positions: p, normals: n, indices: i };
+    let geo = Geometry::new(m, vec![]);
+    let mut rng = Rng::new(2);
+    for _ in 0..1000 {
+        let o = rand_dir(&mut rng) * 3.0;
+        let h = geo.intersect(&Ray::new(o, -o)).unwrap();
+        assert!(h.ns.dot(h.point.p.normalize()) > 0.999);
+        assert!(h.point.n.dot(h.ns) > 0.0);
+        assert!((h.ns.length() - 1.0).abs() < 1e-5);
+    }
+}

@@ -1,0 +1,178 @@
+//! The scene file's schema. Field names are the TOML keys; `deny_unknown_fields` everywhere.
+//!
+//! ```toml
+//! name = "cornell-spheres"
+//! seed = 1
+//! [camera]
+//! eye = [-6.95, 6.86, 14.026]
+//! look_at = [-6.95, 6.86, -6.99]
+//! up = [0, 1, 0]
+//! vfov = 53.13
+//! width = 512
+//! height = 512
+//! [[mesh]]
+//! obj = "CornellBox.obj"      # relative to the scene file
+//! scale = 0.025               # a number or [x, y, z]
+//! rotate = [0, 180, 0]        # degrees about x, then y, then z
+//! emission = "ka"             # the course's MTL files keep emission in Ka
+//! [[sphere]]
+//! center = [-10.505, 2.2907, -9.2368]
+//! radius = 2.25
+//! material = "silver"
+//! [material.silver]
+//! type = "metal"
+//! reflectance = [0.96, 0.98, 0.96]
+//! ```
+
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    #[serde(default)]
+    pub name: String,
+    /// Seed of every random stream of the run.
+    #[serde(default)]
+    pub seed: u64,
+    pub camera: CameraDesc,
+    #[serde(default)]
+    pub render: RenderSettings,
+    #[serde(default, rename = "mesh")]
+    pub meshes: Vec<MeshDesc>,
+    #[serde(default, rename = "sphere")]
+    pub spheres: Vec<SphereDesc>,
+    /// Materials by name. They override MTL materials of the same name.
+    #[serde(default, rename = "material")]
+    pub materials: BTreeMap<String, MaterialDesc>,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    pub eye: [f32; 3],
+    pub look_at: [f32; 3],
+    #[serde(default = "default_up")]
+    pub up: [f32; 3],
+    /// Vertical field of view in degrees.
+    pub vfov: f32,
+    pub width: u32,
+    pub height: u32,
+}
+
+fn default_up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+/// Eye-pass settings. Every field has a default so a scene file may leave it out.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct RenderSettings {
+    /// Samples per pixel of the path tracer.
+    pub spp: u32,
+    /// Longest path (number of bounces) before it is cut.
+    pub max_depth: u32,
+    /// Russian roulette starts after this many bounces.
+    pub rr_depth: u32,
+    /// Tile edge in pixels for parallel rendering (does not change the image).
+    pub tile: u32,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            spp: 16,
+            max_depth: 64,
+            rr_depth: 3,
+            tile: 16,
+        }
+    }
+}
+
+/// Where the MTL files keep emitted radiance.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum EmissionSource {
+    /// `Ke`, the MTL standard.
+    #[default]
+    Ke,
+    /// `Ka`, the course framework's convention.
+    Ka,
+}
+
+/// How vertex normals are obtained.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum NormalMode {
+    /// The file's normals if it has them, else flat.
+    #[default]
+    Auto,
+    /// Face normals only.
+    Flat,
+    /// Angle-weighted vertex normals computed at load (ignores the file's normals).
+    Smooth,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum Scale {
+    Uniform(f32),
+    PerAxis([f32; 3]),
+}
+
+impl Default for Scale {
+    fn default() -> Self {
+        Scale::Uniform(1.0)
+    }
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MeshDesc {
+    /// OBJ file, relative to the scene file.
+    pub obj: String,
+    #[serde(default)]
+    pub scale: Scale,
+    /// Rotation in degrees about x, then y, then z.
+    #[serde(default)]
+    pub rotate: [f32; 3],
+    #[serde(default)]
+    pub translate: [f32; 3],
+    #[serde(default)]
+    pub emission: EmissionSource,
+    #[serde(default)]
+    pub normals: NormalMode,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SphereDesc {
+    pub center: [f32; 3],
+    pub radius: f32,
+    pub material: String,
+}
+
+/// A material written in the scene file.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum MaterialDesc {
+    Lambertian {
+        albedo: [f32; 3],
+        #[serde(default)]
+        emission: [f32; 3],
+    },
+    Mirror {
+        #[serde(default = "one3")]
+        reflectance: [f32; 3],
+    },
+    Metal {
+        reflectance: [f32; 3],
+    },
+    Dielectric {
+        ior: f32,
+    },
+}
+
+fn one3() -> [f32; 3] {
+    [1.0; 3]
+}

@@ -1,0 +1,28 @@
+//! `scene`: turns a scene file into a ready-to-trace [`Scene`].
+//!
+//! Key decision: **one TOML file holds every parameter of a run** (Tungsten's habit, style
+//! anchor A3): mesh files and their transforms, spheres, materials, camera, seed and render
+//! settings. Its keys are the `snake_case` names of the Rust fields (anchor A2.4) and unknown
+//! keys are errors, so a typo never silently falls back to a default.
+//!
+//! Loading never panics: every problem is a [`SceneError`] naming the file and what is wrong
+//! with it. This crate reads exactly the files its scene file names (the OBJ and MTL files)
+//! and nothing else.
+
+mod camera;
+mod error;
+mod file;
+mod load;
+mod material;
+
+pub use camera::Camera;
+pub use error::SceneError;
+pub use file::{
+    CameraDesc, EmissionSource, MaterialDesc, MeshDesc, NormalMode, RenderSettings, SceneFile,
+    SphereDesc,
+};
+pub use load::{AreaLight, Scene, fnv1a64};
+pub use material::Material;
+
+#[cfg(test)]
+mod tests;

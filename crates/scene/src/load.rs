@@ -1,0 +1,505 @@
+use crate::file::{EmissionSource, MaterialDesc, MeshDesc, NormalMode, Scale, SceneFile};
+use crate::{Camera, Material, RenderSettings, SceneError};
+use geom::{Geometry, Sphere, TriMesh, smooth_vertex_normals};
+use glam::{DMat3, DMat4, DVec3, Vec3};
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+
+/// One emissive triangle. Emission is one-sided, towards `normal`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AreaLight {
+    pub triangle: u32,
+    pub area: f32,
+    /// Emitted radiance.
+    pub le: Vec3,
+    /// Unit normal of the emitting side.
+    pub normal: Vec3,
+    /// Emitted power `pi * area * le` of a Lambertian emitter.
+    pub power: Vec3,
+}
+
+/// A loaded scene, ready to trace.
+pub struct Scene {
+    pub path: PathBuf,
+    pub file: SceneFile,
+    pub geometry: Geometry,
+    pub materials: Vec<Material>,
+    pub material_names: Vec<String>,
+    /// Emitted radiance per material (zero for non-emitters).
+    pub emission: Vec<Vec3>,
+    pub lights: Vec<AreaLight>,
+    pub camera: Camera,
+    /// FNV-1a hash of the scene file and every file it names, in order: photon caches are
+    /// keyed by it, so any edit to any input invalidates them.
+    pub content_hash: u64,
+}
+
+impl Scene {
+    pub fn seed(&self) -> u64 {
+        self.file.seed
+    }
+
+    pub fn render(&self) -> &RenderSettings {
+        &self.file.render
+    }
+
+    /// Total emitted power of all lights, summed in f64.
+    pub fn light_power(&self) -> Vec3 {
+        let s = self
+            .lights
+            .iter()
+            .fold(DVec3::ZERO, |s, l| s + l.power.as_dvec3());
+        s.as_vec3()
+    }
+
+    pub fn light_area(&self) -> f64 {
+        self.lights.iter().map(|l| l.area as f64).sum()
+    }
+
+    pub fn material_of(&self, name: &str) -> Option<u32> {
+        self.material_names
+            .iter()
+            .position(|n| n == name)
+            .map(|i| i as u32)
+    }
+
+    /// Load a scene file and every file it names.
+    pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| SceneError::new(path, format!("cannot read scene file: {e}")))?;
+        Scene::from_toml(path, &text)
+    }
+
+    /// Parse scene text as if it were read from `path` (mesh paths are relative to it).
+    pub fn from_toml(path: &Path, text: &str) -> Result<Scene, SceneError> {
+        let file: SceneFile = toml::from_str(text)
+            .map_err(|e| SceneError::new(path, format!("malformed scene file: {}", e.message())
+                + &location(text, e.span())))?;
+        let mut hash = Fnv::new();
+        hash.write(text.as_bytes());
+        Builder::new(path, &file, &mut hash).build(file.clone())
+    }
+}
+
+fn location(text: &str, span: Option<std::ops::Range<usize>>) -> String {
+    match span {
+        Some(r) => {
+            let line = text[..r.start.min(text.len())].matches('\n').count() + 1;
+            let snippet = text[r.clone()].lines().next().unwrap_or("").trim();
+            format!(" (line {line}: `{snippet}`)")
+        }
+        None => String::new(),
+    }
+}
+
+struct Builder<'a> {
+    scene_path: &'a Path,
+    dir: PathBuf,
+    hash: &'a mut Fnv,
+    mesh: TriMesh,
+    spheres: Vec<Sphere>,
+    materials: Vec<Material>,
+    names: Vec<String>,
+    emission: Vec<Vec3>,
+    by_name: HashMap<String, u32>,
+}
+
+impl<'a> Builder<'a> {
+    fn new(scene_path: &'a Path, file: &SceneFile, hash: &'a mut Fnv) -> Builder<'a> {
+        let dir = scene_path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let mut b = Builder {
+            scene_path,
+            dir,
+            hash,
+            mesh: TriMesh::default(),
+            spheres: Vec::new(),
+            materials: Vec::new(),
+            names: Vec::new(),
+            emission: Vec::new(),
+            by_name: HashMap::new(),
+        };
+        // Scene-file materials first: they win over MTL materials of the same name.
+        for (name, desc) in &file.materials {
+            let (m, e) = match desc {
+                MaterialDesc::Lambertian { albedo, emission } => (
+                    Material::Lambertian {
+                        albedo: Vec3::from(*albedo),
+                    },
+                    Vec3::from(*emission),
+                ),
+                MaterialDesc::Mirror { reflectance } => (
+                    Material::Mirror {
+                        reflectance: Vec3::from(*reflectance),
+                    },
+                    Vec3::ZERO,
+                ),
+                MaterialDesc::Metal { reflectance } => (
+                    Material::Metal {
+                        reflectance: Vec3::from(*reflectance),
+                    },
+                    Vec3::ZERO,
+                ),
+                MaterialDesc::Dielectric { ior } => (Material::Dielectric { ior: *ior }, Vec3::ZERO),
+            };
+            b.add_material(name, m, e);
+        }
+        b
+    }
+
+    fn add_material(&mut self, name: &str, m: Material, e: Vec3) -> u32 {
+        let id = self.materials.len() as u32;
+        self.materials.push(m);
+        self.names.push(name.to_string());
+        self.emission.push(e);
+        self.by_name.insert(name.to_string(), id);
+        id
+    }
+
+    fn err(&self, problem: impl Into<String>) -> SceneError {
+        SceneError::new(self.scene_path, problem)
+    }
+
+    fn build(mut self, file: SceneFile) -> Result<Scene, SceneError> {
+        self.validate_materials()?;
+        for (i, m) in file.meshes.iter().enumerate() {
+            self.load_mesh(i, m)?;
+        }
+        for (i, s) in file.spheres.iter().enumerate() {
+            let c = Vec3::from(s.center);
+            if !c.is_finite() || !(s.radius.is_finite() && s.radius > 0.0) {
+                return Err(self.err(format!(
+                    "sphere {i}: centre must be finite and radius a positive number (got {:?}, {})",
+                    s.center, s.radius
+                )));
+            }
+            let Some(&mat) = self.by_name.get(&s.material) else {
+                return Err(self.err(format!(
+                    "sphere {i}: unknown material `{}` (known: {})",
+                    s.material,
+                    self.names.join(", ")
+                )));
+            };
+            self.spheres.push(Sphere {
+                center: c,
+                radius: s.radius,
+                material: mat,
+            });
+        }
+        let c = &file.camera;
+        let camera = Camera::new(
+            c.eye.into(),
+            c.look_at.into(),
+            c.up.into(),
+            c.vfov,
+            c.width,
+            c.height,
+        )
+        .filter(|_| [c.eye, c.look_at, c.up].iter().flatten().all(|v| v.is_finite()))
+        .ok_or_else(|| {
+            self.err(format!(
+                "camera: needs distinct finite eye and look_at, an up vector not along the view, \
+                 0 < vfov < 180 and a non-empty image (got eye {:?}, look_at {:?}, up {:?}, vfov {}, {}x{})",
+                c.eye, c.look_at, c.up, c.vfov, c.width, c.height
+            ))
+        })?;
+        if c.width as u64 * c.height as u64 > 1 << 28 {
+            return Err(self.err(format!("camera: {}x{} pixels is absurd", c.width, c.height)));
+        }
+        let r = &file.render;
+        if r.spp == 0 || r.spp > 1 << 24 {
+            return Err(self.err(format!("render.spp = {} must be in 1..=16777216", r.spp)));
+        }
+        if r.tile == 0 || r.tile > 4096 {
+            return Err(self.err(format!("render.tile = {} must be in 1..=4096", r.tile)));
+        }
+
+        let mut lights = Vec::new();
+        for t in 0..self.mesh.len() {
+            let e = self.emission[self.mesh.materials[t] as usize];
+            if e.max_element() <= 0.0 {
+                continue;
+            }
+            let area = self.mesh.area(t);
+            let n = self.mesh.face_normal(t);
+            if !(area > 0.0) || n.try_normalize().is_none() {
+                return Err(self.err(format!(
+                    "zero-area light: triangle {t} (material `{}`) emits but has no area",
+                    self.names[self.mesh.materials[t] as usize]
+                )));
+            }
+            lights.push(AreaLight {
+                triangle: t as u32,
+                area,
+                le: e,
+                normal: n.normalize(),
+                power: (std::f64::consts::PI * area as f64 * e.as_dvec3()).as_vec3(),
+            });
+        }
+        if lights.is_empty() {
+            let hint = if file.meshes.iter().any(|m| m.emission == EmissionSource::Ke) {
+                " (hint: the course's MTL files keep emission in Ka: set emission = \"ka\" on the mesh)"
+            } else {
+                ""
+            };
+            return Err(self.err(format!("the scene has no light: no triangle emits{hint}")));
+        }
+        if self.spheres.iter().any(|s| self.emission[s.material as usize].max_element() > 0.0) {
+            return Err(self.err("emissive spheres are not supported: lights are triangles"));
+        }
+
+        let content_hash = self.hash.finish();
+        Ok(Scene {
+            path: self.scene_path.to_path_buf(),
+            file,
+            geometry: Geometry::new(self.mesh, self.spheres),
+            materials: self.materials,
+            material_names: self.names,
+            emission: self.emission,
+            lights,
+            camera,
+            content_hash,
+        })
+    }
+
+    fn validate_materials(&self) -> Result<(), SceneError> {
+        for (name, m) in self.names.iter().zip(&self.materials) {
+            let ok = match m {
+                Material::Lambertian { albedo } => in_unit(*albedo),
+                Material::Mirror { reflectance } | Material::Metal { reflectance } => {
+                    in_unit(*reflectance)
+                }
+                Material::Dielectric { ior } => ior.is_finite() && *ior > 0.0 && *ior < 10.0,
+            };
+            if !ok {
+                return Err(self.err(format!(
+                    "material `{name}`: albedo/reflectance must lie in [0, 1] and ior in (0, 10) (got {m:?})"
+                )));
+            }
+        }
+        for (name, e) in self.names.iter().zip(&self.emission) {
+            if !(e.is_finite() && e.min_element() >= 0.0) {
+                return Err(self.err(format!("material `{name}`: emission must be finite and >= 0")));
+            }
+        }
+        Ok(())
+    }
+
+    fn load_mesh(&mut self, index: usize, desc: &MeshDesc) -> Result<(), SceneError> {
+        let obj_path = self.dir.join(&desc.obj);
+        let bytes = std::fs::read(&obj_path).map_err(|e| {
+            SceneError::new(&obj_path, format!("cannot read OBJ file (mesh {index} of {}): {e}",
+                self.scene_path.display()))
+        })?;
+        self.hash.write(desc.obj.as_bytes());
+        self.hash.write(&bytes);
+
+        // tobj asks for MTL files by the name in `mtllib`; read them ourselves so a missing or
+        // broken one is reported with its path.
+        let obj_dir = obj_path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let mtl_error: RefCell<Option<SceneError>> = RefCell::new(None);
+        let mtl_bytes: RefCell<Vec<u8>> = RefCell::new(Vec::new());
+        let loaded = tobj::load_obj_buf(
+            &mut BufReader::new(&bytes[..]),
+            &tobj::LoadOptions {
+                triangulate: true,
+                single_index: true,
+                ..Default::default()
+            },
+            |p| {
+                let mtl_path = obj_dir.join(p);
+                match std::fs::read(&mtl_path) {
+                    Ok(b) => {
+                        mtl_bytes.borrow_mut().extend_from_slice(&b);
+                        tobj::load_mtl_buf(&mut BufReader::new(&b[..])).inspect_err(|e| {
+                            *mtl_error.borrow_mut() = Some(SceneError::new(
+                                &mtl_path,
+                                format!("malformed MTL file: {e}"),
+                            ));
+                        })
+                    }
+                    Err(e) => {
+                        *mtl_error.borrow_mut() = Some(SceneError::new(
+                            &mtl_path,
+                            format!("cannot read MTL file named by `mtllib` in {}: {e}", obj_path.display()),
+                        ));
+                        Err(tobj::LoadError::OpenFileFailed)
+                    }
+                }
+            },
+        );
+        if let Some(e) = mtl_error.into_inner() {
+            return Err(e);
+        }
+        self.hash.write(&mtl_bytes.into_inner());
+        let (models, materials) = loaded
+            .map_err(|e| SceneError::new(&obj_path, format!("malformed OBJ file: {e}")))?;
+        let materials = materials
+            .map_err(|e| SceneError::new(&obj_path, format!("its materials failed to load: {e}")))?;
+
+        // MTL materials → ids (scene-file materials of the same name win).
+        let mut mat_ids = Vec::with_capacity(materials.len());
+        for m in &materials {
+            let id = match self.by_name.get(&m.name) {
+                Some(&id) => id,
+                None => {
+                    let (mat, e) = convert_mtl(m, desc.emission).map_err(|p| {
+                        SceneError::new(&obj_path, format!("material `{}`: {p}", m.name))
+                    })?;
+                    self.add_material(&m.name, mat, e)
+                }
+            };
+            mat_ids.push(id);
+        }
+        self.validate_materials()
+            .map_err(|e| SceneError::new(&obj_path, e.problem))?;
+
+        let xf = transform(desc).ok_or_else(|| {
+            self.err(format!("mesh {index} ({}): transform must be finite with a non-zero scale", desc.obj))
+        })?;
+        let nxf = DMat3::from_mat4(xf).inverse().transpose();
+        for model in &models {
+            let m = &model.mesh;
+            let nv = m.positions.len() / 3;
+            let mut part = TriMesh::default();
+            for (v, p) in m.positions.chunks_exact(3).enumerate() {
+                let p = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+                if !p.is_finite() {
+                    return Err(SceneError::new(&obj_path, format!(
+                        "object `{}`: vertex {} is not finite ({:?})", model.name, v + 1, p.to_array())));
+                }
+                part.positions.push(xf.transform_point3(p).as_vec3());
+            }
+            let use_file_normals = matches!(desc.normals, NormalMode::Auto) && m.normals.len() == 3 * nv;
+            if use_file_normals {
+                for (v, n) in m.normals.chunks_exact(3).enumerate() {
+                    let n = DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64);
+                    let n = (nxf * n).normalize_or_zero();
+                    if !n.is_finite() || n == DVec3::ZERO {
+                        return Err(SceneError::new(&obj_path, format!(
+                            "object `{}`: normal {} is zero or not finite", model.name, v + 1)));
+                    }
+                    part.normals.push(n.as_vec3());
+                }
+            }
+            let mat = match m.material_id {
+                Some(i) if i < mat_ids.len() => mat_ids[i],
+                Some(i) => {
+                    return Err(SceneError::new(&obj_path, format!(
+                        "object `{}` uses material index {i} that its MTL does not define", model.name)));
+                }
+                None => {
+                    return Err(SceneError::new(&obj_path, format!(
+                        "object `{}` has no material (no `usemtl`)", model.name)));
+                }
+            };
+            for t in m.indices.chunks_exact(3) {
+                if t.iter().any(|&i| i as usize >= nv) {
+                    return Err(SceneError::new(&obj_path, format!(
+                        "object `{}`: face index out of range", model.name)));
+                }
+                part.indices.push([t[0], t[1], t[2]]);
+                part.materials.push(mat);
+            }
+            if desc.normals == NormalMode::Smooth {
+                part.normals = smooth_vertex_normals(&part.positions, &part.indices);
+            }
+            self.mesh.append(&part);
+        }
+        Ok(())
+    }
+}
+
+fn in_unit(v: Vec3) -> bool {
+    v.is_finite() && v.min_element() >= 0.0 && v.max_element() <= 1.0
+}
+
+/// The MTL → material mapping of `Material`'s docs.
+fn convert_mtl(m: &tobj::Material, emission: EmissionSource) -> Result<(Material, Vec3), String> {
+    let v = |a: Option<[f32; 3]>| a.map(Vec3::from).unwrap_or(Vec3::ZERO);
+    let kd = v(m.diffuse);
+    let ks = m.specular.map(Vec3::from).unwrap_or(Vec3::ONE);
+    let e = match emission {
+        EmissionSource::Ke => v(m.emissive),
+        EmissionSource::Ka => v(m.ambient),
+    };
+    let ni = m.optical_density.unwrap_or(1.0);
+    let transparent = m.dissolve.is_some_and(|d| d < 1.0);
+    let mat = match m.illumination_model {
+        None | Some(0..=2) if transparent && ni > 1.0 => Material::Dielectric { ior: ni },
+        None | Some(0..=2) => Material::Lambertian { albedo: kd },
+        Some(3) => Material::Mirror { reflectance: ks },
+        Some(4 | 6 | 7) => Material::Dielectric { ior: ni },
+        Some(11) => Material::Metal { reflectance: ks },
+        Some(c @ (5 | 8 | 9 | 10 | 12 | 13 | 14)) => {
+            return Err(format!(
+                "illum {c} is a valid MTL code that photonflow does not render \
+                 (supported: 0-2 diffuse, 3 mirror, 4/6/7 glass, 11 metal)"
+            ));
+        }
+        Some(c) => {
+            return Err(format!(
+                "unknown illum code {c} (supported: 0-2 diffuse, 3 mirror, 4/6/7 glass, 11 metal)"
+            ));
+        }
+    };
+    Ok((mat, e))
+}
+
+/// Scale, then rotate about x, y, z (degrees), then translate. Built in f64 with entries that
+/// are zero to 1e-12 snapped to zero, so a 180-degree turn keeps axis-aligned walls exact.
+fn transform(d: &MeshDesc) -> Option<DMat4> {
+    let s = match d.scale {
+        Scale::Uniform(s) => DVec3::splat(s as f64),
+        Scale::PerAxis(a) => DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64),
+    };
+    let r = DVec3::new(d.rotate[0] as f64, d.rotate[1] as f64, d.rotate[2] as f64);
+    let t = DVec3::new(d.translate[0] as f64, d.translate[1] as f64, d.translate[2] as f64);
+    if !(s.is_finite() && r.is_finite() && t.is_finite()) || s.x * s.y * s.z == 0.0 {
+        return None;
+    }
+    let rot = DMat3::from_rotation_z(r.z.to_radians())
+        * DMat3::from_rotation_y(r.y.to_radians())
+        * DMat3::from_rotation_x(r.x.to_radians());
+    let snap = |c: DVec3| {
+        DVec3::from_array(c.to_array().map(|x| {
+            if x.abs() < 1e-12 {
+                0.0
+            } else if (x.abs() - 1.0).abs() < 1e-12 {
+                x.signum()
+            } else {
+                x
+            }
+        }))
+    };
+    let rot = DMat3::from_cols(snap(rot.x_axis), snap(rot.y_axis), snap(rot.z_axis));
+    Some(DMat4::from_translation(t) * DMat4::from_mat3(rot * DMat3::from_diagonal(s)))
+}
+
+/// 64-bit FNV-1a: a stable, dependency-free content hash (not for security).
+struct Fnv(u64);
+
+impl Fnv {
+    fn new() -> Fnv {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        // Length prefix so ("ab", "c") and ("a", "bc") differ.
+        for b in (bytes.len() as u64).to_le_bytes().iter().chain(bytes) {
+            self.0 ^= *b as u64;
+            self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+/// FNV-1a of a byte string (exposed for photon-cache keys built from parameters).
+pub fn fnv1a64(bytes: &[u8]) -> u64 {
+    let mut h = Fnv::new();
+    h.write(bytes);
+    h.finish()
+}

@@ -1,0 +1,41 @@
+//! Hand-rolled argument parsing: xtask keeps no dependencies so it compiles in seconds.
+
+pub const HELP: &str = "\
+cargo xtask <command>
+
+  bench rays [SCENE] [--runs N] [--compare]
+                      single-thread rays/s: 1M coherent camera rays and 1M incoherent rays
+                      (default scene: scenes/cornell-spheres/tessellated.toml);
+                      --compare also measures the binary BVH (Bvh2) next to CwBvh
+  info SCENE          load a scene and print what it holds
+  gen-scenes          rewrite the generated OBJ/MTL files under scenes/
+";
+
+pub enum Cmd {
+    Help,
+    GenScenes,
+    /// Arguments passed straight to the photonflow binary.
+    Photonflow(Vec<String>),
+}
+
+pub const DEFAULT_SCENE: &str = "scenes/cornell-spheres/tessellated.toml";
+
+pub fn parse(args: &[String]) -> Result<Cmd, String> {
+    let a: Vec<&str> = args.iter().map(String::as_str).collect();
+    match a.as_slice() {
+        [] | ["help" | "-h" | "--help", ..] => Ok(Cmd::Help),
+        ["gen-scenes"] => Ok(Cmd::GenScenes),
+        ["info", rest @ ..] => Ok(Cmd::Photonflow(
+            std::iter::once("info").chain(rest.iter().copied()).map(String::from).collect(),
+        )),
+        ["bench", "rays", rest @ ..] => {
+            let mut out = vec!["bench-rays".to_string()];
+            if rest.first().is_none_or(|s| s.starts_with("--")) {
+                out.push(DEFAULT_SCENE.into());
+            }
+            out.extend(rest.iter().map(|s| s.to_string()));
+            Ok(Cmd::Photonflow(out))
+        }
+        [other, ..] => Err(format!("unknown command `{other}`\n\n{HELP}")),
+    }
+}
