@@ -35,8 +35,7 @@ impl ToneMap {
     /// One linear channel value to an 8-bit code. Computed in f64.
     pub fn apply(&self, v: f32) -> u8 {
         let x = f64::from(v) * f64::from(self.exposure).exp2();
-        // `!(x > 0)` also catches NaN.
-        if !(x > 0.0) {
+        if x.is_nan() || x <= 0.0 {
             return 0;
         }
         if x >= 1.0 {
