@@ -63,7 +63,7 @@ fn all_models() -> Vec<(&'static str, Bsdf)> {
     ]
 }
 
-/// Gold's complex index at ~650/550/450 nm (pbrt-v4 scenes' "metal-Au" spectra, sampled).
+/// A commonly quoted RGB fit of gold's complex index; any absorbing metal would do here.
 fn gold() -> Bsdf {
     Conductor {
         eta: Vec3::new(0.143, 0.374, 1.442),
@@ -512,4 +512,29 @@ fn lambertian_sampling_passes_chi2() {
         )
         .unwrap_or_else(|e| panic!("wo {wo}: {e}"));
     }
+}
+
+#[test]
+fn chi2_catches_a_forgotten_hemisphere_flip() {
+    // The classic bug: sampling below the surface for wo.z < 0 but evaluating the pdf of the
+    // upper hemisphere. The harness must reject it (and name the seed).
+    let b: Bsdf = Lambertian {
+        albedo: Vec3::splat(0.5),
+    }
+    .into();
+    let wo = dir(120.0, 10.0);
+    let err = chi2_test_sidak(
+        1,
+        51,
+        101,
+        50_000,
+        500,
+        |rng| {
+            b.sample(wo, rng.uniform(), rng.uniform2(), RAD)
+                .map(|s| s.wi)
+        },
+        |wi| math::warp::cosine_hemisphere_pdf(wi) as f64,
+    )
+    .unwrap_err();
+    assert!(err.contains("seed 500"), "{err}");
 }
