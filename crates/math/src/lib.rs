@@ -6,9 +6,14 @@
 //! reproduces the same numbers bit for bit (anchor A1.8, pbrt-v4's SPPM photon indexing).
 //! Vectors are `glam`'s; this crate adds what glam lacks.
 
+pub mod chi2;
+mod frame;
 mod rng;
+pub mod warp;
 
+pub use frame::Frame;
 pub use rng::{Rng, mix64};
+pub use warp::{Distribution1D, power_heuristic};
 
 #[cfg(test)]
 mod tests;

@@ -1,5 +1,10 @@
 use crate::Rng;
 
+// The warp, frame and chi-square tests live in tests/ (one file per module).
+mod chi2;
+mod frame;
+mod warp;
+
 #[test]
 fn streams_are_pure_functions_of_seed_and_index() {
     let a: Vec<u32> = {
@@ -14,7 +19,10 @@ fn streams_are_pure_functions_of_seed_and_index() {
     };
     assert_eq!(a, b);
     let mut c = Rng::for_index(7, 12346);
-    assert_ne!(a[0..4], (0..4).map(|_| c.next_u32()).collect::<Vec<_>>()[..]);
+    assert_ne!(
+        a[0..4],
+        (0..4).map(|_| c.next_u32()).collect::<Vec<_>>()[..]
+    );
 }
 
 #[test]

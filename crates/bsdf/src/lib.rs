@@ -1,0 +1,224 @@
+//! `bsdf`: how surfaces scatter light, in the local shading frame (z = shading normal).
+//!
+//! Key decision: a *closed enum* ([`Bsdf`]) over a handful of models, not a trait object. The
+//! material set is fixed by the scene format (MTL illum models), so a `match` gives static
+//! dispatch, `Copy` values a photon tracer can stash per hit without allocating, and one
+//! place to see every model (Mitsuba 3 and pbrt-v4 dispatch over a closed set too, via
+//! `TaggedPointer`). Sampling never owns an RNG: callers pass the uniforms (pbrt-v4 §9.1.2).
+//!
+//! Conventions (pbrt-v4 §9.1): `wo` and `wi` point away from the surface, in the local frame
+//! (callers convert with [`math::Frame`]); `f` is RGB; for a delta lobe `pdf` is the discrete
+//! probability of having picked that lobe and `f` is set so `f · |cos θi| / pdf` is the
+//! throughput factor, so one estimator serves smooth and delta lobes alike.
+
+mod conductor;
+mod dielectric;
+mod lambertian;
+mod metal;
+mod mirror;
+pub mod optics;
+
+pub use conductor::Conductor;
+pub use dielectric::Dielectric;
+pub use lambertian::Lambertian;
+pub use metal::Metal;
+pub use mirror::Mirror;
+pub use optics::{fresnel_conductor, fresnel_dielectric, reflect, refract};
+
+use glam::Vec3;
+use std::ops::BitOr;
+
+/// What a path carries. Cameras trace `Radiance`; photons from lights carry `Importance`-like
+/// flux. Only refraction's `1/η²` radiance scaling differs: BSDFs with refraction are not
+/// symmetric, so the adjoint differs (Veach 1997 §5.2; pbrt-v4 §9.5.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TransportMode {
+    Radiance,
+    Importance,
+}
+
+/// Lobe kind of a sample: reflection or transmission, diffuse or specular (pbrt-v4 §9.1.2's
+/// `BxDFFlags`, reduced to what these models produce).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Flags(u8);
+
+impl Flags {
+    pub const REFLECTION: Flags = Flags(1);
+    pub const TRANSMISSION: Flags = Flags(2);
+    pub const DIFFUSE: Flags = Flags(4);
+    pub const SPECULAR: Flags = Flags(8);
+    pub const DIFFUSE_REFLECTION: Flags = Flags(1 | 4);
+    pub const SPECULAR_REFLECTION: Flags = Flags(1 | 8);
+    pub const SPECULAR_TRANSMISSION: Flags = Flags(2 | 8);
+
+    #[inline]
+    pub const fn contains(self, other: Flags) -> bool {
+        self.0 & other.0 == other.0
+    }
+    #[inline]
+    pub const fn is_reflection(self) -> bool {
+        self.contains(Flags::REFLECTION)
+    }
+    #[inline]
+    pub const fn is_transmission(self) -> bool {
+        self.contains(Flags::TRANSMISSION)
+    }
+    #[inline]
+    pub const fn is_diffuse(self) -> bool {
+        self.contains(Flags::DIFFUSE)
+    }
+    #[inline]
+    pub const fn is_specular(self) -> bool {
+        self.contains(Flags::SPECULAR)
+    }
+}
+
+impl BitOr for Flags {
+    type Output = Flags;
+    fn bitor(self, rhs: Flags) -> Flags {
+        Flags(self.0 | rhs.0)
+    }
+}
+
+/// A sampled incident direction with its BSDF value and probability.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfSample {
+    /// BSDF value (RGB). For delta lobes, chosen so `f · |cos θi| / pdf` is the throughput.
+    pub f: Vec3,
+    pub wi: Vec3,
+    /// Solid-angle density, or for a delta lobe the probability of having chosen it.
+    pub pdf: f32,
+    pub flags: Flags,
+    /// Relative index crossed (`η'`; 1 for reflection), for Russian roulette and `1/η²`
+    /// bookkeeping (pbrt-v4 §14.1.4).
+    pub eta: f32,
+}
+
+impl BsdfSample {
+    #[inline]
+    pub fn is_specular(&self) -> bool {
+        self.flags.is_specular()
+    }
+    #[inline]
+    pub fn is_reflection(&self) -> bool {
+        self.flags.is_reflection()
+    }
+    #[inline]
+    pub fn is_transmission(&self) -> bool {
+        self.flags.is_transmission()
+    }
+    /// `f · |cos θi| / pdf`, the factor a path's throughput is multiplied by.
+    #[inline]
+    pub fn weight(&self) -> Vec3 {
+        self.f * self.wi.z.abs() / self.pdf
+    }
+}
+
+/// Every scattering model the renderer knows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Bsdf {
+    Lambertian(Lambertian),
+    Mirror(Mirror),
+    Metal(Metal),
+    Conductor(Conductor),
+    Dielectric(Dielectric),
+}
+
+impl Bsdf {
+    /// BSDF value for a pair of directions; 0 for delta models, whose value is a Dirac
+    /// distribution no pair of directions drawn independently can hit.
+    pub fn f(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> Vec3 {
+        // A grazing wo has no hemisphere (pbrt-v4 `BSDF::f`).
+        if wo.z == 0.0 {
+            return Vec3::ZERO;
+        }
+        match self {
+            Bsdf::Lambertian(b) => b.f(wo, wi),
+            Bsdf::Mirror(_) | Bsdf::Metal(_) | Bsdf::Conductor(_) | Bsdf::Dielectric(_) => {
+                Vec3::ZERO
+            }
+        }
+    }
+
+    /// Solid-angle density of [`Bsdf::sample`] producing `wi`; 0 for delta models.
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z == 0.0 {
+            return 0.0;
+        }
+        match self {
+            Bsdf::Lambertian(b) => b.pdf(wo, wi),
+            Bsdf::Mirror(_) | Bsdf::Metal(_) | Bsdf::Conductor(_) | Bsdf::Dielectric(_) => 0.0,
+        }
+    }
+
+    /// Sample `wi` given `wo`: `uc` picks a lobe (dielectric: reflect or refract), `u` the
+    /// direction within it. `None` when no direction carries energy.
+    pub fn sample(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: [f32; 2],
+        mode: TransportMode,
+    ) -> Option<BsdfSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let s = match self {
+            Bsdf::Lambertian(b) => b.sample(wo, u),
+            Bsdf::Mirror(b) => b.sample(wo),
+            Bsdf::Metal(b) => b.sample(wo),
+            Bsdf::Conductor(b) => b.sample(wo),
+            Bsdf::Dielectric(b) => b.sample(wo, uc, mode),
+        }?;
+        debug_assert!(s.pdf > 0.0 && s.f.is_finite(), "bad sample {s:?}");
+        Some(s)
+    }
+
+    /// True when every lobe is a delta: light sampling cannot help, skip next-event estimation.
+    pub fn is_delta(&self) -> bool {
+        !matches!(self, Bsdf::Lambertian(_))
+    }
+
+    /// True for a diffuse lobe: where photons are stored and density estimation is used.
+    pub fn is_diffuse(&self) -> bool {
+        matches!(self, Bsdf::Lambertian(_))
+    }
+
+    pub fn has_transmission(&self) -> bool {
+        matches!(self, Bsdf::Dielectric(_))
+    }
+}
+
+macro_rules! impl_from {
+    ($($t:ident),*) => {$(
+        impl From<$t> for Bsdf {
+            fn from(b: $t) -> Bsdf {
+                Bsdf::$t(b)
+            }
+        }
+    )*};
+}
+impl_from!(Lambertian, Mirror, Metal, Conductor, Dielectric);
+
+/// Both directions on the same side of the surface (local frame).
+#[inline]
+pub(crate) fn same_hemisphere(a: Vec3, b: Vec3) -> bool {
+    a.z * b.z > 0.0
+}
+
+/// Delta reflection about +z scaled by `r`: `f = r / |cos θi|` with pdf 1, so the throughput
+/// is exactly `r` (pbrt-v4 §9.3, `ConductorBxDF` smooth case).
+#[inline]
+pub(crate) fn specular_reflection(wo: Vec3, r: Vec3) -> BsdfSample {
+    let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+    BsdfSample {
+        f: r / wi.z.abs(),
+        wi,
+        pdf: 1.0,
+        flags: Flags::SPECULAR_REFLECTION,
+        eta: 1.0,
+    }
+}
+
+#[cfg(test)]
+mod tests;
