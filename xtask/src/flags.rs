@@ -26,7 +26,10 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
         [] | ["help" | "-h" | "--help", ..] => Ok(Cmd::Help),
         ["gen-scenes"] => Ok(Cmd::GenScenes),
         ["info", rest @ ..] => Ok(Cmd::Photonflow(
-            std::iter::once("info").chain(rest.iter().copied()).map(String::from).collect(),
+            std::iter::once("info")
+                .chain(rest.iter().copied())
+                .map(String::from)
+                .collect(),
         )),
         ["bench", "rays", rest @ ..] => {
             let mut out = vec!["bench-rays".to_string()];

@@ -55,7 +55,9 @@ fn photonflow(args: &[String]) -> Result<(), String> {
     let target = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| root.join("target"));
-    let exe = target.join("release").join(format!("photonflow{}", std::env::consts::EXE_SUFFIX));
+    let exe = target
+        .join("release")
+        .join(format!("photonflow{}", std::env::consts::EXE_SUFFIX));
     let status = Command::new(&exe)
         .current_dir(&root)
         .args(args)

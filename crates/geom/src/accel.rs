@@ -137,7 +137,10 @@ impl Geometry {
         let mut best_t = ray.t_max;
         let mut best: Option<Prim> = None;
         for (i, s) in self.spheres.iter().enumerate() {
-            if let Some(t) = s.intersect(&Ray { t_max: best_t, ..*ray }) {
+            if let Some(t) = s.intersect(&Ray {
+                t_max: best_t,
+                ..*ray
+            }) {
                 best_t = t;
                 best = Some(Prim::Sphere(i as u32));
             }
@@ -147,12 +150,8 @@ impl Geometry {
         let rt = &self.rt;
         let found = match &self.accel {
             Accel::None => false,
-            Accel::CwBvh(b) => {
-                b.ray_traverse(oray, &mut hit, |r, i| intersect_triangle(&rt[i], r))
-            }
-            Accel::Bvh2(b) => {
-                b.ray_traverse(oray, &mut hit, |r, i| intersect_triangle(&rt[i], r))
-            }
+            Accel::CwBvh(b) => b.ray_traverse(oray, &mut hit, |r, i| intersect_triangle(&rt[i], r)),
+            Accel::Bvh2(b) => b.ray_traverse(oray, &mut hit, |r, i| intersect_triangle(&rt[i], r)),
         };
         if found && hit.t < best_t {
             best_t = hit.t;
@@ -183,14 +182,23 @@ impl Geometry {
         let mut best_t = ray.t_max;
         let mut best = None;
         for (i, s) in self.spheres.iter().enumerate() {
-            if let Some(t) = s.intersect(&Ray { t_max: best_t, ..*ray }) {
+            if let Some(t) = s.intersect(&Ray {
+                t_max: best_t,
+                ..*ray
+            }) {
                 best_t = t;
                 best = Some(Prim::Sphere(i as u32));
             }
         }
         let oray = to_obvhs(ray, best_t);
         for (slot, tri) in self.rt.iter().enumerate() {
-            let t = intersect_triangle(tri, &obvhs::ray::Ray { tmax: best_t, ..oray });
+            let t = intersect_triangle(
+                tri,
+                &obvhs::ray::Ray {
+                    tmax: best_t,
+                    ..oray
+                },
+            );
             if t < best_t {
                 best_t = t;
                 best = Some(Prim::Triangle(slot as u32));

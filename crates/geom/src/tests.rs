@@ -41,7 +41,12 @@ fn uv_sphere(c: Vec3, r: f32, slices: u32, stacks: u32) -> (Vec<Vec3>, Vec<[u32;
     }
     for i in 1..stacks - 1 {
         for j in 0..slices {
-            let (a, b, cc, d) = (ring(i, j), ring(i, j + 1), ring(i + 1, j + 1), ring(i + 1, j));
+            let (a, b, cc, d) = (
+                ring(i, j),
+                ring(i, j + 1),
+                ring(i + 1, j + 1),
+                ring(i + 1, j),
+            );
             idx.push([a, b, cc]);
             idx.push([a, cc, d]);
         }
@@ -97,7 +102,8 @@ fn triangle_hits_agree_with_f64_cramer_reference() {
         let _ = k;
         let o = rand_vec(&mut rng, -3.0, 3.0);
         // Aim at a random point near the triangle so about half the rays hit.
-        let target = p[0] + (p[1] - p[0]) * 1.4 * rng.uniform() + (p[2] - p[0]) * 1.4 * rng.uniform();
+        let target =
+            p[0] + (p[1] - p[0]) * 1.4 * rng.uniform() + (p[2] - p[0]) * 1.4 * rng.uniform();
         let ray = Ray::new(o, target - o);
         let reference = ref_triangle(o.as_dvec3(), ray.d.as_dvec3(), p.map(|v| v.as_dvec3()));
         let got = geo.intersect(&ray);
@@ -123,7 +129,10 @@ fn triangle_hits_agree_with_f64_cramer_reference() {
             }
         }
     }
-    assert!(hits > 5_000, "too few hits ({hits}) for the test to mean anything");
+    assert!(
+        hits > 5_000,
+        "too few hits ({hits}) for the test to mean anything"
+    );
     assert!(near_edge < 20, "{near_edge} edge disagreements");
 }
 
@@ -148,7 +157,14 @@ fn sphere_hits_agree_with_geometric_reference() {
     for _ in 0..20_000 {
         let c = rand_vec(&mut rng, -5.0, 5.0);
         let r = 0.1 + 2.0 * rng.uniform();
-        let geo = Geometry::new(TriMesh::default(), vec![Sphere { center: c, radius: r, material: 7 }]);
+        let geo = Geometry::new(
+            TriMesh::default(),
+            vec![Sphere {
+                center: c,
+                radius: r,
+                material: 7,
+            }],
+        );
         // Origins inside and outside; directions aimed near the sphere.
         let o = c + rand_dir(&mut rng) * r * 3.0 * rng.uniform();
         let d = (c + rand_dir(&mut rng) * r * 1.2 - o) * (0.5 + rng.uniform());
@@ -168,7 +184,11 @@ fn sphere_hits_agree_with_geometric_reference() {
                 let dn = d.normalize().as_dvec3();
                 let oc = c.as_dvec3() - o.as_dvec3();
                 let h = (oc - oc.dot(dn) * dn).length();
-                assert!((h - r as f64).abs() < 1e-5 * r as f64, "{a:?} vs {:?}", b.map(|h| h.t));
+                assert!(
+                    (h - r as f64).abs() < 1e-5 * r as f64,
+                    "{a:?} vs {:?}",
+                    b.map(|h| h.t)
+                );
             }
         }
     }
@@ -195,11 +215,21 @@ fn test_scene(kind: BvhKind) -> Geometry {
             [c, c + (t[1] - c) * 0.1, c + (t[2] - c) * 0.1]
         })
         .collect();
-    let idx = (0..2000u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+    let idx = (0..2000u32)
+        .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+        .collect();
     parts.push((soup, idx));
     let spheres = vec![
-        Sphere { center: Vec3::new(-2.0, 1.0, 0.0), radius: 1.0, material: 10 },
-        Sphere { center: Vec3::new(2.5, -1.0, -2.0), radius: 0.7, material: 11 },
+        Sphere {
+            center: Vec3::new(-2.0, 1.0, 0.0),
+            radius: 1.0,
+            material: 10,
+        },
+        Sphere {
+            center: Vec3::new(2.5, -1.0, -2.0),
+            radius: 0.7,
+            material: 11,
+        },
     ];
     Geometry::with_bvh(mesh_of(&parts), spheres, kind)
 }
@@ -220,15 +250,26 @@ fn bvh_closest_hits_equal_brute_force() {
                     assert_eq!(a.t, b.t, "{kind:?}");
                     // Equal t on two primitives happens only on shared edges.
                     if a.prim != b.prim {
-                        assert!(a.uv.iter().chain(&b.uv).any(|x| *x < 1e-5 || *x > 1.0 - 1e-5));
+                        assert!(
+                            a.uv.iter()
+                                .chain(&b.uv)
+                                .any(|x| *x < 1e-5 || *x > 1.0 - 1e-5)
+                        );
                     }
                 }
                 (None, None) => {}
-                (a, b) => panic!("{kind:?}: bvh {:?} vs brute {:?}", a.map(|h| h.t), b.map(|h| h.t)),
+                (a, b) => panic!(
+                    "{kind:?}: bvh {:?} vs brute {:?}",
+                    a.map(|h| h.t),
+                    b.map(|h| h.t)
+                ),
             }
             // Shadow queries agree with the closest hit.
             let seg = Ray { t_max: 3.0, ..ray };
-            assert_eq!(geo.occluded(&seg), geo.intersect_brute_force(&seg).is_some());
+            assert_eq!(
+                geo.occluded(&seg),
+                geo.intersect_brute_force(&seg).is_some()
+            );
         }
         assert!(hits > 1_000, "{kind:?}: {hits} hits");
     }
@@ -252,13 +293,23 @@ fn spawned_rays_never_rehit_their_surface_at_any_scale() {
         );
         let geo = Geometry::new(
             mesh_of(&[(sp, si), tilted]),
-            vec![Sphere { center: off + Vec3::new(-3.0, 0.0, 0.0) * s, radius: s, material: 9 }],
+            vec![Sphere {
+                center: off + Vec3::new(-3.0, 0.0, 0.0) * s,
+                radius: s,
+                material: 9,
+            }],
         );
-        for target in [Vec3::new(2.0, 0.0, 0.0), Vec3::new(-0.5, 0.0, 0.0), Vec3::new(-3.0, 0.0, 0.0)] {
+        for target in [
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(-0.5, 0.0, 0.0),
+            Vec3::new(-3.0, 0.0, 0.0),
+        ] {
             for _ in 0..200 {
                 let o = off + (target + rand_dir(&mut rng) * 3.0) * s;
                 let aim = off + (target + rand_dir(&mut rng) * 0.5) * s;
-                let Some(h) = geo.intersect(&Ray::new(o, aim - o)) else { continue };
+                let Some(h) = geo.intersect(&Ray::new(o, aim - o)) else {
+                    continue;
+                };
                 for _ in 0..50 {
                     let w = rand_dir(&mut rng);
                     let r = h.point.spawn_ray(w);
@@ -288,9 +339,7 @@ fn spawned_rays_never_rehit_their_surface_at_any_scale() {
                         assert!(
                             ok,
                             "scale {s}: re-hit {:?} at t = {} from {:?}",
-                            h2.prim,
-                            h2.t,
-                            h.prim
+                            h2.prim, h2.t, h.prim
                         );
                     }
                 }
@@ -327,13 +376,27 @@ fn light_under_the_ceiling_is_reachable_from_the_floor_and_not_through_the_ceili
     let light_id = |p: Prim| matches!(p, Prim::Triangle(2) | Prim::Triangle(3));
     let mut rng = Rng::new(8);
     for _ in 0..2_000 {
-        let lp = Vec3::new(-8.575 + 3.25 * rng.uniform(), y_l, -8.3 + 2.625 * rng.uniform());
+        let lp = Vec3::new(
+            -8.575 + 3.25 * rng.uniform(),
+            y_l,
+            -8.3 + 2.625 * rng.uniform(),
+        );
         // Find the light point by a ray from below, as a path tracer would.
-        let fp = Vec3::new(-13.0 + 12.0 * rng.uniform(), 0.0, -13.0 + 12.0 * rng.uniform());
+        let fp = Vec3::new(
+            -13.0 + 12.0 * rng.uniform(),
+            0.0,
+            -13.0 + 12.0 * rng.uniform(),
+        );
         let down = geo.intersect(&Ray::new(fp + Vec3::Y, Vec3::NEG_Y)).unwrap();
         assert!(matches!(down.prim, Prim::Triangle(4) | Prim::Triangle(5)));
-        let up = geo.intersect(&down.point.spawn_ray(lp - down.point.p)).unwrap();
-        assert!(light_id(up.prim), "floor ray to the light hit {:?}", up.prim);
+        let up = geo
+            .intersect(&down.point.spawn_ray(lp - down.point.p))
+            .unwrap();
+        assert!(
+            light_id(up.prim),
+            "floor ray to the light hit {:?}",
+            up.prim
+        );
         // Shadow ray between the two surface points is clear.
         assert!(!geo.occluded(&down.point.spawn_ray_to_point(&up.point)));
         // From the light's back side upwards: the ceiling, 0.0025 away, not the sky.
@@ -345,7 +408,12 @@ fn light_under_the_ceiling_is_reachable_from_the_floor_and_not_through_the_ceili
         assert!(light_id(c.prim) && (c.t - 0.0025).abs() < 1e-4);
         // From above the ceiling the light is hidden.
         let above = lp + Vec3::Y * 5.0;
-        let blocked = SurfacePoint { p: above, p_err: Vec3::ZERO, n: Vec3::Y }.spawn_ray_to(lp);
+        let blocked = SurfacePoint {
+            p: above,
+            p_err: Vec3::ZERO,
+            n: Vec3::Y,
+        }
+        .spawn_ray_to(lp);
         assert!(geo.occluded(&blocked));
     }
 }
@@ -366,7 +434,12 @@ fn shading_normals_interpolate_and_face_the_same_side() {
     let c = Vec3::ZERO;
     let (p, i) = uv_sphere(c, 1.0, 32, 16);
     let n = smooth_vertex_normals(&p, &i);
-    let m = TriMesh { materials: vec![0; i.len()], positions: p, normals: n, indices: i };
+    let m = TriMesh {
+        materials: vec![0; i.len()],
+        positions: p,
+        normals: n,
+        indices: i,
+    };
     let geo = Geometry::new(m, vec![]);
     let mut rng = Rng::new(2);
     for _ in 0..1000 {

@@ -75,9 +75,12 @@ impl Scene {
 
     /// Parse scene text as if it were read from `path` (mesh paths are relative to it).
     pub fn from_toml(path: &Path, text: &str) -> Result<Scene, SceneError> {
-        let file: SceneFile = toml::from_str(text)
-            .map_err(|e| SceneError::new(path, format!("malformed scene file: {}", e.message())
-                + &location(text, e.span())))?;
+        let file: SceneFile = toml::from_str(text).map_err(|e| {
+            SceneError::new(
+                path,
+                format!("malformed scene file: {}", e.message()) + &location(text, e.span()),
+            )
+        })?;
         let mut hash = Fnv::new();
         hash.write(text.as_bytes());
         Builder::new(path, &file, &mut hash).build(file.clone())
@@ -109,7 +112,10 @@ struct Builder<'a> {
 
 impl<'a> Builder<'a> {
     fn new(scene_path: &'a Path, file: &SceneFile, hash: &'a mut Fnv) -> Builder<'a> {
-        let dir = scene_path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let dir = scene_path
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
         let mut b = Builder {
             scene_path,
             dir,
@@ -142,7 +148,9 @@ impl<'a> Builder<'a> {
                     },
                     Vec3::ZERO,
                 ),
-                MaterialDesc::Dielectric { ior } => (Material::Dielectric { ior: *ior }, Vec3::ZERO),
+                MaterialDesc::Dielectric { ior } => {
+                    (Material::Dielectric { ior: *ior }, Vec3::ZERO)
+                }
             };
             b.add_material(name, m, e);
         }
@@ -246,7 +254,11 @@ impl<'a> Builder<'a> {
             };
             return Err(self.err(format!("the scene has no light: no triangle emits{hint}")));
         }
-        if self.spheres.iter().any(|s| self.emission[s.material as usize].max_element() > 0.0) {
+        if self
+            .spheres
+            .iter()
+            .any(|s| self.emission[s.material as usize].max_element() > 0.0)
+        {
             return Err(self.err("emissive spheres are not supported: lights are triangles"));
         }
 
@@ -281,7 +293,9 @@ impl<'a> Builder<'a> {
         }
         for (name, e) in self.names.iter().zip(&self.emission) {
             if !(e.is_finite() && e.min_element() >= 0.0) {
-                return Err(self.err(format!("material `{name}`: emission must be finite and >= 0")));
+                return Err(self.err(format!(
+                    "material `{name}`: emission must be finite and >= 0"
+                )));
             }
         }
         Ok(())
@@ -290,8 +304,13 @@ impl<'a> Builder<'a> {
     fn load_mesh(&mut self, index: usize, desc: &MeshDesc) -> Result<(), SceneError> {
         let obj_path = self.dir.join(&desc.obj);
         let bytes = std::fs::read(&obj_path).map_err(|e| {
-            SceneError::new(&obj_path, format!("cannot read OBJ file (mesh {index} of {}): {e}",
-                self.scene_path.display()))
+            SceneError::new(
+                &obj_path,
+                format!(
+                    "cannot read OBJ file (mesh {index} of {}): {e}",
+                    self.scene_path.display()
+                ),
+            )
         })?;
         self.hash.write(desc.obj.as_bytes());
         self.hash.write(&bytes);
@@ -323,7 +342,10 @@ impl<'a> Builder<'a> {
                     Err(e) => {
                         *mtl_error.borrow_mut() = Some(SceneError::new(
                             &mtl_path,
-                            format!("cannot read MTL file named by `mtllib` in {}: {e}", obj_path.display()),
+                            format!(
+                                "cannot read MTL file named by `mtllib` in {}: {e}",
+                                obj_path.display()
+                            ),
                         ));
                         Err(tobj::LoadError::OpenFileFailed)
                     }
@@ -334,10 +356,11 @@ impl<'a> Builder<'a> {
             return Err(e);
         }
         self.hash.write(&mtl_bytes.into_inner());
-        let (models, materials) = loaded
-            .map_err(|e| SceneError::new(&obj_path, format!("malformed OBJ file: {e}")))?;
-        let materials = materials
-            .map_err(|e| SceneError::new(&obj_path, format!("its materials failed to load: {e}")))?;
+        let (models, materials) =
+            loaded.map_err(|e| SceneError::new(&obj_path, format!("malformed OBJ file: {e}")))?;
+        let materials = materials.map_err(|e| {
+            SceneError::new(&obj_path, format!("its materials failed to load: {e}"))
+        })?;
 
         // MTL materials → ids (scene-file materials of the same name win).
         let mut mat_ids = Vec::with_capacity(materials.len());
@@ -357,7 +380,10 @@ impl<'a> Builder<'a> {
             .map_err(|e| SceneError::new(&obj_path, e.problem))?;
 
         let xf = transform(desc).ok_or_else(|| {
-            self.err(format!("mesh {index} ({}): transform must be finite with a non-zero scale", desc.obj))
+            self.err(format!(
+                "mesh {index} ({}): transform must be finite with a non-zero scale",
+                desc.obj
+            ))
         })?;
         let nxf = DMat3::from_mat4(xf).inverse().transpose();
         for model in &models {
@@ -367,19 +393,33 @@ impl<'a> Builder<'a> {
             for (v, p) in m.positions.chunks_exact(3).enumerate() {
                 let p = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
                 if !p.is_finite() {
-                    return Err(SceneError::new(&obj_path, format!(
-                        "object `{}`: vertex {} is not finite ({:?})", model.name, v + 1, p.to_array())));
+                    return Err(SceneError::new(
+                        &obj_path,
+                        format!(
+                            "object `{}`: vertex {} is not finite ({:?})",
+                            model.name,
+                            v + 1,
+                            p.to_array()
+                        ),
+                    ));
                 }
                 part.positions.push(xf.transform_point3(p).as_vec3());
             }
-            let use_file_normals = matches!(desc.normals, NormalMode::Auto) && m.normals.len() == 3 * nv;
+            let use_file_normals =
+                matches!(desc.normals, NormalMode::Auto) && m.normals.len() == 3 * nv;
             if use_file_normals {
                 for (v, n) in m.normals.chunks_exact(3).enumerate() {
                     let n = DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64);
                     let n = (nxf * n).normalize_or_zero();
                     if !n.is_finite() || n == DVec3::ZERO {
-                        return Err(SceneError::new(&obj_path, format!(
-                            "object `{}`: normal {} is zero or not finite", model.name, v + 1)));
+                        return Err(SceneError::new(
+                            &obj_path,
+                            format!(
+                                "object `{}`: normal {} is zero or not finite",
+                                model.name,
+                                v + 1
+                            ),
+                        ));
                     }
                     part.normals.push(n.as_vec3());
                 }
@@ -387,18 +427,27 @@ impl<'a> Builder<'a> {
             let mat = match m.material_id {
                 Some(i) if i < mat_ids.len() => mat_ids[i],
                 Some(i) => {
-                    return Err(SceneError::new(&obj_path, format!(
-                        "object `{}` uses material index {i} that its MTL does not define", model.name)));
+                    return Err(SceneError::new(
+                        &obj_path,
+                        format!(
+                            "object `{}` uses material index {i} that its MTL does not define",
+                            model.name
+                        ),
+                    ));
                 }
                 None => {
-                    return Err(SceneError::new(&obj_path, format!(
-                        "object `{}` has no material (no `usemtl`)", model.name)));
+                    return Err(SceneError::new(
+                        &obj_path,
+                        format!("object `{}` has no material (no `usemtl`)", model.name),
+                    ));
                 }
             };
             for t in m.indices.chunks_exact(3) {
                 if t.iter().any(|&i| i as usize >= nv) {
-                    return Err(SceneError::new(&obj_path, format!(
-                        "object `{}`: face index out of range", model.name)));
+                    return Err(SceneError::new(
+                        &obj_path,
+                        format!("object `{}`: face index out of range", model.name),
+                    ));
                 }
                 part.indices.push([t[0], t[1], t[2]]);
                 part.materials.push(mat);
@@ -456,7 +505,11 @@ fn transform(d: &MeshDesc) -> Option<DMat4> {
         Scale::PerAxis(a) => DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64),
     };
     let r = DVec3::new(d.rotate[0] as f64, d.rotate[1] as f64, d.rotate[2] as f64);
-    let t = DVec3::new(d.translate[0] as f64, d.translate[1] as f64, d.translate[2] as f64);
+    let t = DVec3::new(
+        d.translate[0] as f64,
+        d.translate[1] as f64,
+        d.translate[2] as f64,
+    );
     if !(s.is_finite() && r.is_finite() && t.is_finite()) || s.x * s.y * s.z == 0.0 {
         return None;
     }

@@ -1,0 +1,407 @@
+//! Scene loading against the numbers of scene-facts.md, and every kind of bad input.
+
+use crate::{Material, Scene};
+use glam::Vec3;
+use std::path::{Path, PathBuf};
+
+fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
+fn load(rel: &str) -> Scene {
+    let p = scenes_dir().join(rel);
+    Scene::load(&p).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn close(a: Vec3, b: Vec3, tol: f32) -> bool {
+    (a - b).abs().max_element() <= tol
+}
+
+#[test]
+fn tessellated_cornell_matches_the_worksheet_scene() {
+    let s = load("cornell-spheres/tessellated.toml");
+    // Box: 6 quads = 12 triangles; each UV sphere 2 * 64 * 63 = 8064.
+    assert_eq!(s.geometry.mesh().len(), 12 + 2 * 8064);
+    assert_eq!(s.geometry.spheres().len(), 0);
+    assert_eq!(
+        s.lights.len(),
+        2,
+        "the light quad is two emissive triangles"
+    );
+    check_light(&s);
+    // Every sphere vertex lies 2.25 (= 90 * 0.025) from its transformed centre.
+    let m = s.geometry.mesh();
+    for (name, c) in [
+        ("silver", Vec3::new(-10.505, 2.29075, -9.23675)),
+        ("glass", Vec3::new(-3.272, 2.29, -6.2395)),
+    ] {
+        let id = s.material_of(name).unwrap();
+        let tris: Vec<usize> = (0..m.len()).filter(|&t| m.materials[t] == id).collect();
+        assert_eq!(tris.len(), 8064, "{name}");
+        for &t in &tris {
+            for p in m.vertices(t) {
+                assert!(((p - c).length() - 2.25).abs() < 2e-5, "{name}: {p:?}");
+            }
+            // Smooth normals are radial and the winding faces out.
+            let [a, _, _] = m.indices[t];
+            assert!(m.normals[a as usize].dot((m.positions[a as usize] - c).normalize()) > 0.9999);
+            assert!(m.face_normal(t).dot(m.vertices(t)[0] - c) > 0.0);
+        }
+    }
+    assert_eq!(
+        s.materials[s.material_of("silver").unwrap() as usize],
+        Material::Metal {
+            reflectance: Vec3::new(0.96, 0.98, 0.96)
+        }
+    );
+    assert_eq!(
+        s.materials[s.material_of("glass").unwrap() as usize],
+        Material::Dielectric { ior: 1.5 }
+    );
+    assert_eq!(
+        s.materials[s.material_of("red").unwrap() as usize],
+        Material::Lambertian {
+            albedo: Vec3::new(0.9, 0.0, 0.0)
+        }
+    );
+}
+
+#[test]
+fn analytic_cornell_matches_the_worksheet_scene() {
+    let s = load("cornell-spheres/analytic.toml");
+    assert_eq!(s.geometry.mesh().len(), 12);
+    assert_eq!(s.geometry.spheres().len(), 2);
+    assert_eq!(s.lights.len(), 2);
+    check_light(&s);
+    let sp = s.geometry.spheres();
+    assert!(close(
+        sp[0].center,
+        Vec3::new(-10.505, 2.2907, -9.2368),
+        1e-4
+    ));
+    // scene-facts gives 2.2901 for 0.025 * 91.60 = 2.29: rounding in the source.
+    assert!(close(
+        sp[1].center,
+        Vec3::new(-3.2720, 2.2901, -6.2395),
+        2e-4
+    ));
+    assert!(sp.iter().all(|s| s.radius == 2.25));
+    // Camera of the course: 53.13 degrees puts the image plane at [-0.5, 0.5] at distance 1.
+    let c = &s.camera;
+    assert_eq!((c.width, c.height), (512, 512));
+    let corner = c.ray(0.0, 0.0).d;
+    let d = corner / corner.dot(c.forward());
+    assert!(
+        (d.y - 0.5).abs() < 1e-4 && (d.x + 0.5).abs() < 1e-4,
+        "{d:?}"
+    );
+}
+
+fn check_light(s: &Scene) {
+    // Area 130 mm x 105 mm x 0.025^2 = 8.53125; power = pi A Le.
+    assert!(
+        (s.light_area() - 8.53125).abs() < 1e-5,
+        "area {}",
+        s.light_area()
+    );
+    let le = Vec3::new(36.8, 31.2, 16.0);
+    let expect = (std::f64::consts::PI * 8.53125) as f32 * le;
+    assert!(
+        close(s.light_power(), expect, 1e-3),
+        "{:?} vs {expect:?}",
+        s.light_power()
+    );
+    assert!(close(s.light_power(), Vec3::new(986.3, 836.2, 428.8), 0.1));
+    for l in &s.lights {
+        assert_eq!(l.le, le);
+        assert!(close(l.normal, Vec3::NEG_Y, 1e-6), "faces down");
+        for p in s.geometry.mesh().vertices(l.triangle as usize) {
+            assert!((p.y - 13.7175).abs() < 1e-5);
+            assert!(
+                (-8.575..=-5.325).contains(&p.x) && (-8.3..=-5.675).contains(&p.z),
+                "{p:?}"
+            );
+        }
+    }
+    // 0.0025 below the ceiling.
+    let ceiling = s.material_of("white").unwrap();
+    let m = s.geometry.mesh();
+    let top = (0..m.len())
+        .filter(|&t| m.materials[t] == ceiling)
+        .flat_map(|t| m.vertices(t))
+        .map(|p| p.y)
+        .fold(f32::MIN, f32::max);
+    assert!((top - 13.72).abs() < 1e-5 && ((top - 13.7175) - 0.0025).abs() < 1e-5);
+}
+
+#[test]
+fn every_scene_in_the_tree_loads() {
+    for rel in [
+        "cornell-spheres/tessellated.toml",
+        "cornell-spheres/analytic.toml",
+        "furnace/furnace.toml",
+        "plane-light/plane-light.toml",
+        "corner/corner.toml",
+    ] {
+        let s = load(rel);
+        assert!(
+            !s.lights.is_empty() && s.light_power().min_element() > 0.0,
+            "{rel}"
+        );
+    }
+}
+
+#[test]
+fn content_hash_changes_with_any_input() {
+    let a = load("cornell-spheres/analytic.toml");
+    let b = load("cornell-spheres/analytic.toml");
+    assert_eq!(a.content_hash, b.content_hash);
+    let text = std::fs::read_to_string(scenes_dir().join("cornell-spheres/analytic.toml")).unwrap();
+    let edited = text.replace("ior = 1.5", "ior = 1.51");
+    let c = Scene::from_toml(&scenes_dir().join("cornell-spheres/analytic.toml"), &edited).unwrap();
+    assert_ne!(a.content_hash, c.content_hash);
+}
+
+/// A scratch directory with the given files; removed on drop.
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn new(name: &str, files: &[(&str, &str)]) -> Scratch {
+        let dir =
+            std::env::temp_dir().join(format!("photonflow-scene-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        for (f, text) in files {
+            std::fs::write(dir.join(f), text).unwrap();
+        }
+        Scratch(dir)
+    }
+    fn path(&self, f: &str) -> PathBuf {
+        self.0.join(f)
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+const CAMERA: &str =
+    "[camera]\neye = [0, 1, 3]\nlook_at = [0, 0, 0]\nvfov = 60\nwidth = 8\nheight = 8\n";
+const GOOD_OBJ: &str = "mtllib m.mtl\no floor\nusemtl white\nv -1 0 -1\nv -1 0 1\nv 1 0 1\nv 1 0 -1\nf 1 2 3\nf 1 3 4\n\
+o light\nusemtl light\nv -0.1 1 -0.1\nv 0.1 1 -0.1\nv 0.1 1 0.1\nv -0.1 1 0.1\nf 5 6 7\nf 5 7 8\n";
+const GOOD_MTL: &str = "newmtl white\nKd 0.5 0.5 0.5\nnewmtl light\nKd 0 0 0\nKe 4 4 4\n";
+
+fn scene_toml(obj: &str) -> String {
+    format!("{CAMERA}[[mesh]]\nobj = \"{obj}\"\n")
+}
+
+/// Load a scene from files and return the error text, which must name `file`.
+fn error_of(name: &str, files: &[(&str, &str)], file: &str, problem: &str) {
+    let dir = Scratch::new(name, files);
+    let err = match Scene::load(dir.path("s.toml")) {
+        Ok(_) => panic!("{name}: loaded although broken"),
+        Err(e) => e,
+    };
+    let text = err.to_string();
+    assert!(
+        err.file.ends_with(file),
+        "{name}: error names {:?}, not {file}: {text}",
+        err.file
+    );
+    assert!(
+        text.contains(problem),
+        "{name}: `{text}` does not say `{problem}`"
+    );
+}
+
+#[test]
+fn the_good_scene_used_below_loads() {
+    let dir = Scratch::new(
+        "good",
+        &[
+            ("s.toml", &scene_toml("a.obj")),
+            ("a.obj", GOOD_OBJ),
+            ("m.mtl", GOOD_MTL),
+        ],
+    );
+    let s = Scene::load(dir.path("s.toml")).unwrap();
+    assert_eq!(s.lights.len(), 2);
+    assert!((s.light_area() - 0.04).abs() < 1e-6);
+}
+
+#[test]
+fn missing_obj_is_named() {
+    error_of(
+        "noobj",
+        &[("s.toml", &scene_toml("gone.obj"))],
+        "gone.obj",
+        "cannot read OBJ file",
+    );
+}
+
+#[test]
+fn missing_mtl_is_named() {
+    error_of(
+        "nomtl",
+        &[("s.toml", &scene_toml("a.obj")), ("a.obj", GOOD_OBJ)],
+        "m.mtl",
+        "cannot read MTL file",
+    );
+}
+
+#[test]
+fn nan_and_infinite_vertices_are_named() {
+    for (tag, bad) in [("nan", "NaN"), ("inf", "inf")] {
+        let obj = GOOD_OBJ.replace("v 1 0 1", &format!("v 1 {bad} 1"));
+        error_of(
+            tag,
+            &[
+                ("s.toml", &scene_toml("a.obj")),
+                ("a.obj", &obj),
+                ("m.mtl", GOOD_MTL),
+            ],
+            "a.obj",
+            "vertex 3 is not finite",
+        );
+    }
+}
+
+#[test]
+fn unknown_illum_code_is_named() {
+    let mtl = GOOD_MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.5 0.5 0.5\nillum 42");
+    error_of(
+        "illum",
+        &[
+            ("s.toml", &scene_toml("a.obj")),
+            ("a.obj", GOOD_OBJ),
+            ("m.mtl", &mtl),
+        ],
+        "a.obj",
+        "unknown illum code 42",
+    );
+    // A code MTL defines but we do not render is refused too, and says so.
+    let mtl = GOOD_MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.5 0.5 0.5\nillum 5");
+    error_of(
+        "illum5",
+        &[
+            ("s.toml", &scene_toml("a.obj")),
+            ("a.obj", GOOD_OBJ),
+            ("m.mtl", &mtl),
+        ],
+        "a.obj",
+        "illum 5",
+    );
+}
+
+#[test]
+fn a_scene_without_light_is_refused_with_a_hint() {
+    let mtl = GOOD_MTL.replace("Ke 4 4 4", "Ka 4 4 4");
+    error_of(
+        "nolight",
+        &[
+            ("s.toml", &scene_toml("a.obj")),
+            ("a.obj", GOOD_OBJ),
+            ("m.mtl", &mtl),
+        ],
+        "s.toml",
+        "no light",
+    );
+    error_of(
+        "nolight2",
+        &[
+            ("s.toml", &scene_toml("a.obj")),
+            ("a.obj", GOOD_OBJ),
+            ("m.mtl", &mtl),
+        ],
+        "s.toml",
+        "emission = \"ka\"",
+    );
+}
+
+#[test]
+fn zero_area_light_is_refused() {
+    let obj = GOOD_OBJ
+        .replace("v 0.1 1 0.1", "v -0.1 1 -0.1")
+        .replace("v 0.1 1 -0.1", "v -0.1 1 -0.1");
+    error_of(
+        "zeroarea",
+        &[
+            ("s.toml", &scene_toml("a.obj")),
+            ("a.obj", &obj),
+            ("m.mtl", GOOD_MTL),
+        ],
+        "s.toml",
+        "zero-area light",
+    );
+}
+
+#[test]
+fn malformed_toml_values_are_named_with_their_line() {
+    let toml = scene_toml("a.obj").replace("vfov = 60", "vfov = \"wide\"");
+    error_of(
+        "toml",
+        &[("s.toml", &toml), ("a.obj", GOOD_OBJ), ("m.mtl", GOOD_MTL)],
+        "s.toml",
+        "line 4",
+    );
+    let toml = scene_toml("a.obj") + "spp = 4\n";
+    error_of(
+        "unknown-key",
+        &[("s.toml", &toml), ("a.obj", GOOD_OBJ), ("m.mtl", GOOD_MTL)],
+        "s.toml",
+        "unknown field `spp`",
+    );
+    let toml = scene_toml("a.obj") + "[render]\nspp = 0\n";
+    error_of(
+        "spp0",
+        &[("s.toml", &toml), ("a.obj", GOOD_OBJ), ("m.mtl", GOOD_MTL)],
+        "s.toml",
+        "render.spp = 0",
+    );
+    let toml = scene_toml("a.obj").replace("look_at = [0, 0, 0]", "look_at = [0, 1, 3]");
+    error_of(
+        "camera",
+        &[("s.toml", &toml), ("a.obj", GOOD_OBJ), ("m.mtl", GOOD_MTL)],
+        "s.toml",
+        "camera",
+    );
+}
+
+#[test]
+fn broken_obj_and_mtl_syntax_are_named() {
+    let obj = GOOD_OBJ.replace("f 1 2 3", "f 1 x 3");
+    error_of(
+        "badobj",
+        &[
+            ("s.toml", &scene_toml("a.obj")),
+            ("a.obj", &obj),
+            ("m.mtl", GOOD_MTL),
+        ],
+        "a.obj",
+        "malformed OBJ",
+    );
+    let mtl = GOOD_MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.5 zero 0.5");
+    error_of(
+        "badmtl",
+        &[
+            ("s.toml", &scene_toml("a.obj")),
+            ("a.obj", GOOD_OBJ),
+            ("m.mtl", &mtl),
+        ],
+        "m.mtl",
+        "malformed MTL",
+    );
+    let obj = GOOD_OBJ.replace("f 1 3 4", "f 1 3 40");
+    error_of(
+        "badidx",
+        &[
+            ("s.toml", &scene_toml("a.obj")),
+            ("a.obj", &obj),
+            ("m.mtl", GOOD_MTL),
+        ],
+        "a.obj",
+        "",
+    );
+}
