@@ -14,8 +14,10 @@ cargo xtask <command>
 pub enum Cmd {
     Help,
     GenScenes,
-    /// Arguments passed straight to the photonflow binary.
+    /// Arguments passed straight to the photonflow binary (release build).
     Photonflow(Vec<String>),
+    /// The same, built with the `release-lto` profile for benchmarks.
+    Bench(Vec<String>),
 }
 
 pub const DEFAULT_SCENE: &str = "scenes/cornell-spheres/tessellated.toml";
@@ -37,7 +39,7 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
                 out.push(DEFAULT_SCENE.into());
             }
             out.extend(rest.iter().map(|s| s.to_string()));
-            Ok(Cmd::Photonflow(out))
+            Ok(Cmd::Bench(out))
         }
         [other, ..] => Err(format!("unknown command `{other}`\n\n{HELP}")),
     }

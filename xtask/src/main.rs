@@ -5,6 +5,7 @@
 
 mod flags;
 mod gen_scenes;
+mod tidy;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -28,7 +29,8 @@ fn run(args: &[String]) -> Result<(), String> {
             Ok(())
         }
         flags::Cmd::GenScenes => gen_scenes::run(&project_root()),
-        flags::Cmd::Photonflow(args) => photonflow(&args),
+        flags::Cmd::Photonflow(args) => photonflow("release", &args),
+        flags::Cmd::Bench(args) => photonflow("release-lto", &args),
     }
 }
 
@@ -40,13 +42,21 @@ pub fn project_root() -> PathBuf {
         .to_path_buf()
 }
 
-/// Build the release `photonflow` binary and run it with `args` from the project root.
-fn photonflow(args: &[String]) -> Result<(), String> {
+/// Build the `photonflow` binary with cargo profile `profile` and run it with `args` from the
+/// project root. Benchmarks use `release-lto`, the profile we publish numbers for.
+fn photonflow(profile: &str, args: &[String]) -> Result<(), String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let root = project_root();
     let status = Command::new(&cargo)
         .current_dir(&root)
-        .args(["build", "--quiet", "--release", "--package", "photonflow"])
+        .args([
+            "build",
+            "--quiet",
+            "--profile",
+            profile,
+            "--package",
+            "photonflow",
+        ])
         .status()
         .map_err(|e| format!("cannot run {cargo}: {e}"))?;
     if !status.success() {

@@ -430,11 +430,17 @@ fn layers_are_named_created_on_demand_and_kept_in_insertion_order() {
 }
 
 #[test]
-#[should_panic(expected = "outside layer rect")]
 fn tile_layers_reject_pixels_they_do_not_own() {
+    // Writing outside a tile is a caller bug (a panic, like slice indexing), never a silent
+    // write into a neighbour's pixels.
     let film = Film::new(8, 8);
     let mut tile = film.tile_buffer(Rect::new(0, 0, 4, 4));
-    tile.layer_mut("global").add(4, 0, [1.0; 3]);
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        tile.layer_mut("global").add(4, 0, [1.0; 3]);
+    }));
+    let msg = r.expect_err("a write outside the tile must panic");
+    let msg = msg.downcast_ref::<String>().cloned().unwrap_or_default();
+    assert!(msg.contains("outside layer rect"), "{msg}");
 }
 
 #[test]

@@ -77,9 +77,10 @@ impl Geometry {
                 }
             })
             .collect();
-        // `slow_build` (PLOC with spatial pre-splits) measured fastest to traverse; building
-        // the 16k-triangle Cornell scene takes a few milliseconds either way.
-        let params = BvhBuildParams::slow_build();
+        // `medium_build` traversed as fast as `slow_build` (spatial pre-splits) and
+        // `very_slow_build` on the tessellated Cornell scene (`cargo xtask bench rays`, medians
+        // within noise of each other) and builds in half the time (~10 ms for 16k triangles).
+        let params = BvhBuildParams::medium_build();
         let mut t = Duration::default();
         let (accel, order): (Accel, Vec<u32>) = if tris.is_empty() {
             (Accel::None, Vec::new())
@@ -145,16 +146,33 @@ impl Geometry {
                 best = Some(Prim::Sphere(i as u32));
             }
         }
-        let oray = to_obvhs(ray, best_t);
+        let (shifted, real) = to_obvhs(ray, best_t);
         let mut hit = RayHit::none();
         let rt = &self.rt;
+        // obvhs keeps a candidate exactly when the returned t is below the ray's current
+        // `tmax`; remember the unshifted t of that candidate so no rounding of the shift
+        // reaches the caller.
+        let closest = std::cell::Cell::new(f32::INFINITY);
+        let test = |r: &obvhs::ray::Ray, i: usize| {
+            let real = obvhs::ray::Ray {
+                tmax: r.tmax - T_SHIFT,
+                ..real
+            };
+            let t = intersect_triangle(&rt[i], &real);
+            let ts = t + T_SHIFT;
+            if ts < r.tmax {
+                closest.set(t);
+            }
+            ts
+        };
         let found = match &self.accel {
             Accel::None => false,
-            Accel::CwBvh(b) => b.ray_traverse(oray, &mut hit, |r, i| intersect_triangle(&rt[i], r)),
-            Accel::Bvh2(b) => b.ray_traverse(oray, &mut hit, |r, i| intersect_triangle(&rt[i], r)),
+            Accel::CwBvh(b) => b.ray_traverse(shifted, &mut hit, test),
+            Accel::Bvh2(b) => b.ray_traverse(shifted, &mut hit, test),
         };
-        if found && hit.t < best_t {
-            best_t = hit.t;
+        let t = closest.get();
+        if found && t < best_t {
+            best_t = t;
             best = Some(Prim::Triangle(hit.primitive_id));
         }
         match best? {
@@ -169,11 +187,12 @@ impl Geometry {
             return true;
         }
         let rt = &self.rt;
-        let oray = to_obvhs(ray, ray.t_max);
+        let (shifted, real) = to_obvhs(ray, ray.t_max);
+        let test = |_: &obvhs::ray::Ray, i: usize| intersect_triangle(&rt[i], &real) + T_SHIFT;
         match &self.accel {
             Accel::None => false,
-            Accel::CwBvh(b) => !b.ray_traverse_miss(oray, |r, i| intersect_triangle(&rt[i], r)),
-            Accel::Bvh2(b) => !b.ray_traverse_miss(oray, |r, i| intersect_triangle(&rt[i], r)),
+            Accel::CwBvh(b) => !b.ray_traverse_miss(shifted, test),
+            Accel::Bvh2(b) => !b.ray_traverse_miss(shifted, test),
         }
     }
 
@@ -190,13 +209,13 @@ impl Geometry {
                 best = Some(Prim::Sphere(i as u32));
             }
         }
-        let oray = to_obvhs(ray, best_t);
+        let (_, real) = to_obvhs(ray, best_t);
         for (slot, tri) in self.rt.iter().enumerate() {
             let t = intersect_triangle(
                 tri,
                 &obvhs::ray::Ray {
                     tmax: best_t,
-                    ..oray
+                    ..real
                 },
             );
             if t < best_t {
@@ -263,9 +282,25 @@ impl Geometry {
     }
 }
 
+/// obvhs' `CwBvh` node test clamps the entry distance to `t >= 1e-4` (`cwbvh/node.rs`,
+/// `EPSILON`), so it skips every node that lies entirely closer than that: in our Cornell
+/// scene, the floor as seen from a point 1e-5 above it. A fixed epsilon is exactly what
+/// `spawn_ray` avoids, so traversal gets a ray whose origin is moved back by `T_SHIFT` (in t
+/// units) along its direction; the triangle test uses the true origin and reports
+/// `t + T_SHIFT`. Regression test: `tests/it/cornell.rs`, `bvh_equals_brute_force...`.
+const T_SHIFT: f32 = 2e-4;
+
+/// The traversal ray (origin moved back by `T_SHIFT`) and the true one, both ending at
+/// `t_max` of the caller's ray.
 #[inline]
-fn to_obvhs(ray: &Ray, t_max: f32) -> obvhs::ray::Ray {
-    obvhs::ray::Ray::new(ray.o.into(), ray.d.into(), 0.0, t_max)
+fn to_obvhs(ray: &Ray, t_max: f32) -> (obvhs::ray::Ray, obvhs::ray::Ray) {
+    let real = obvhs::ray::Ray::new(ray.o.into(), ray.d.into(), 0.0, t_max);
+    let shifted = obvhs::ray::Ray {
+        origin: real.origin - T_SHIFT * real.direction,
+        tmax: t_max + T_SHIFT,
+        ..real
+    };
+    (shifted, real)
 }
 
 /// Möller–Trumbore ("Fast, minimum storage ray-triangle intersection", 1997) in the layout of

@@ -450,3 +450,36 @@ fn shading_normals_interpolate_and_face_the_same_side() {
         assert!((h.ns.length() - 1.0).abs() < 1e-5);
     }
 }
+
+#[test]
+fn hits_closer_than_the_bvh_node_epsilon_are_found() {
+    // obvhs' CwBvh skips nodes closer than t = 1e-4; `Geometry` must not (see T_SHIFT).
+    for kind in [BvhKind::CwBvh, BvhKind::Bvh2] {
+        let floor = quad(
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(-1.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, -1.0),
+        );
+        let geo = Geometry::with_bvh(mesh_of(&[floor]), vec![], kind);
+        for h in [1e-7f32, 1e-6, 1e-5, 5e-5, 1e-4, 1e-3] {
+            let ray = Ray::new(Vec3::new(0.3, h, 0.2), Vec3::new(0.1, -1.0, 0.05));
+            let hit = geo
+                .intersect(&ray)
+                .unwrap_or_else(|| panic!("{kind:?}: missed at {h}"));
+            assert!(
+                (hit.t - h).abs() <= 1e-6 * h,
+                "{kind:?}: t {} vs {h}",
+                hit.t
+            );
+            assert!(geo.occluded(&Ray {
+                t_max: 2.0 * h,
+                ..ray
+            }));
+            assert!(!geo.occluded(&Ray {
+                t_max: 0.5 * h,
+                ..ray
+            }));
+        }
+    }
+}

@@ -177,7 +177,7 @@ impl<'a> Builder<'a> {
         }
         for (i, s) in file.spheres.iter().enumerate() {
             let c = Vec3::from(s.center);
-            if !c.is_finite() || !(s.radius.is_finite() && s.radius > 0.0) {
+            if !(c.is_finite() && s.radius.is_finite() && s.radius > 0.0) {
                 return Err(self.err(format!(
                     "sphere {i}: centre must be finite and radius a positive number (got {:?}, {})",
                     s.center, s.radius
@@ -232,7 +232,7 @@ impl<'a> Builder<'a> {
             }
             let area = self.mesh.area(t);
             let n = self.mesh.face_normal(t);
-            if !(area > 0.0) || n.try_normalize().is_none() {
+            if area.is_nan() || area <= 0.0 || n.try_normalize().is_none() {
                 return Err(self.err(format!(
                     "zero-area light: triangle {t} (material `{}`) emits but has no area",
                     self.names[self.mesh.materials[t] as usize]
