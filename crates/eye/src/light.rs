@@ -21,6 +21,8 @@ struct Emitter {
 /// A point sampled on a light, seen from a receiving point.
 #[derive(Clone, Copy, Debug)]
 pub struct LightSample {
+    /// Index of the chosen light (into `scene.lights`).
+    pub light: usize,
     /// The light point with its error bound (for shadow rays) and the light's emitting normal.
     pub point: SurfacePoint,
     /// Emitted radiance towards the receiver (the light faces it: never zero-sided).
@@ -99,7 +101,11 @@ impl LightSampler {
     /// zero when the ray hits the back).
     pub fn le(&self, light: usize, d: Vec3) -> Vec3 {
         let e = &self.emitters[light];
-        if d.dot(e.normal) < 0.0 { e.le } else { Vec3::ZERO }
+        if d.dot(e.normal) < 0.0 {
+            e.le
+        } else {
+            Vec3::ZERO
+        }
     }
 
     /// Samples a light point as seen from `from`: `u_pick` chooses the triangle, `u` the point.
@@ -114,13 +120,13 @@ impl LightSampler {
         let p_err = SurfacePoint::barycentric_error([b.x, b.y, b.z], e.vertices);
         let to = p - from;
         let dist2 = to.length_squared();
-        if !(dist2 > 0.0) {
+        if dist2 <= 0.0 || !dist2.is_finite() {
             return None;
         }
         let dist = dist2.sqrt();
         let wi = to / dist;
         let cos_light = -wi.dot(e.normal);
-        if !(cos_light > 0.0) {
+        if cos_light <= 0.0 || cos_light.is_nan() {
             return None;
         }
         let pdf = pmf / e.area * dist2 / cos_light;
@@ -128,6 +134,7 @@ impl LightSampler {
             return None;
         }
         Some(LightSample {
+            light: i,
             point: SurfacePoint {
                 p,
                 p_err,
@@ -146,11 +153,11 @@ impl LightSampler {
         let e = &self.emitters[light];
         let d = to - from;
         let dist2 = d.length_squared();
-        if !(dist2 > 0.0) {
+        if dist2 <= 0.0 || !dist2.is_finite() {
             return 0.0;
         }
         let cos_light = -d.dot(e.normal) / dist2.sqrt();
-        if !(cos_light > 0.0) {
+        if cos_light <= 0.0 || cos_light.is_nan() {
             return 0.0;
         }
         self.distribution.pmf(light) / e.area * dist2 / cos_light

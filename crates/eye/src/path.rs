@@ -175,11 +175,7 @@ impl<'a> PathTracer<'a> {
         // hit then competes with NEE and is MIS-weighted. `None` after a specular bounce.
         let mut from_diffuse: Option<(Vec3, f32)> = None;
         let mut bounces = 0u32;
-        loop {
-            let Some(hit) = geometry.intersect(&ray) else {
-                break;
-            };
-
+        while let Some(hit) = geometry.intersect(&ray) {
             // Emission found by the path itself.
             if let Some(light) = self.lights.light_of(hit.prim) {
                 let le = self.lights.le(light, ray.d);
@@ -250,9 +246,12 @@ impl<'a> PathTracer<'a> {
             ray = hit.point.spawn_ray(wi);
             bounces += 1;
 
+            if beta == Vec3::ZERO {
+                break;
+            }
             if bounces >= self.opts.rr_depth {
                 let q = beta.max_element().min(MAX_SURVIVAL);
-                if !(u_rr < q) {
+                if u_rr >= q || q.is_nan() {
                     break;
                 }
                 beta /= q;
