@@ -28,9 +28,8 @@ pub enum Part {
     /// `L D S* E`: light arriving straight at the first non-delta vertex from the eye,
     /// by NEE or by a BSDF sample hitting the light (MIS-weighted).
     Direct,
-    /// Every other non-caustic path: `L D (S* D)+ S* E` whose last-but-light vertex is
-    /// reached from the light without a specular bounce, at the second or a later
-    /// non-delta vertex from the eye.
+    /// `L D (S* D)+ S* E`: light arriving without a specular bounce at the second or a later
+    /// non-delta vertex from the eye (NEE, or a MIS-weighted BSDF hit of the light).
     Indirect,
     /// `L S+ D S* E`: the specular chain from the light ends on the first non-delta vertex
     /// from the eye.
