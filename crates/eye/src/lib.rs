@@ -1,0 +1,34 @@
+//! `eye`: the eye pass, a unidirectional path tracer that writes its estimate into film
+//! layers split by *light-path type*.
+//!
+//! Key decision: **every contribution is classified by the path's regular expression at the
+//! moment it is added, and lands in exactly one layer** (`emitted`, `direct`, `indirect`,
+//! `caustic`, `caustic_indirect`; see [`Part`]). Why: the photon stage will estimate caustics
+//! (paths `L S+ D S* E`) by splatting, and the two stages may only be added if they partition
+//! path space. Keeping the classification inside the tracer, next to the MIS weights that
+//! decide which strategy owns which path, makes that partition one `match` to audit; the
+//! [`PathOptions::caustics`] switch removes exactly the caustic layers and leaves every other
+//! layer bit for bit unchanged (the random stream never branches on it), so a caustic layer
+//! made elsewhere can replace them without counting anything twice.
+//!
+//! Other decisions:
+//! - Next-event estimation at every non-delta vertex, combined with BSDF sampling by the power
+//!   heuristic (Veach 1997 ch. 9). Shadow rays are blocked by glass and mirrors, so NEE never
+//!   produces caustics; a light reached by BSDF sampling through one or more specular bounces
+//!   after a diffuse vertex is therefore a caustic with MIS weight 1.
+//! - Pixel sample `s` of pixel `p` draws from `Rng::for_index(seed, p * spp + s)`, tiles
+//!   accumulate in private f64 buffers merged in tile order, so the film is bit-identical for
+//!   any thread count (style anchor A1.8).
+//! - Sampling takes its random numbers as arguments ([`LightSampler::sample`]); only the
+//!   path loop owns an [`math::Rng`].
+
+mod light;
+mod path;
+mod render;
+
+pub use light::{LightSample, LightSampler};
+pub use path::{Part, PathOptions, PathTracer, Radiance, bsdf_of};
+pub use render::{RenderOptions, render};
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,270 @@
+//! The path loop: NEE + BSDF sampling with MIS, Russian roulette, and the classification of
+//! every contribution into one [`Part`].
+
+use crate::LightSampler;
+use bsdf::{Bsdf, Dielectric, Lambertian, Metal, Mirror, TransportMode};
+use geom::Ray;
+use glam::Vec3;
+use math::{Frame, Rng, power_heuristic};
+use scene::{Material, Scene};
+
+/// The scattering model of a scene material.
+pub fn bsdf_of(m: &Material) -> Bsdf {
+    match *m {
+        Material::Lambertian { albedo } => Lambertian { albedo }.into(),
+        Material::Mirror { reflectance } => Mirror { reflectance }.into(),
+        Material::Metal { reflectance } => Metal { reflectance }.into(),
+        Material::Dielectric { ior } => Dielectric { eta: ior }.into(),
+    }
+}
+
+/// Which family of light paths a contribution belongs to (Heckbert's notation, read from the
+/// light: `L` light, `S` specular (delta) bounce, `D` non-delta bounce, `E` eye). The parts
+/// partition path space; their sum is the full image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Part {
+    /// `L S* E`: emission seen directly or through specular chains.
+    Emitted,
+    /// `L D S* E`: light arriving straight at the first non-delta vertex from the eye,
+    /// by NEE or by a BSDF sample hitting the light (MIS-weighted).
+    Direct,
+    /// `L D (S* D)+ S* E`: light arriving without a specular bounce at the second or a later
+    /// non-delta vertex from the eye (NEE, or a MIS-weighted BSDF hit of the light).
+    Indirect,
+    /// `L S+ D S* E`: the specular chain from the light ends on the first non-delta vertex
+    /// from the eye.
+    Caustic,
+    /// `L S+ D (S* D)+ S* E`: the specular chain from the light ends on a later non-delta
+    /// vertex (caustics seen through at least one more diffuse bounce).
+    CausticIndirect,
+}
+
+impl Part {
+    pub const ALL: [Part; 5] = [
+        Part::Emitted,
+        Part::Direct,
+        Part::Indirect,
+        Part::Caustic,
+        Part::CausticIndirect,
+    ];
+
+    /// The film layer name.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Part::Emitted => "emitted",
+            Part::Direct => "direct",
+            Part::Indirect => "indirect",
+            Part::Caustic => "caustic",
+            Part::CausticIndirect => "caustic_indirect",
+        }
+    }
+
+    /// True for the two layers photon splatting may replace.
+    pub const fn is_caustic(self) -> bool {
+        matches!(self, Part::Caustic | Part::CausticIndirect)
+    }
+}
+
+/// One path's radiance estimate, split by [`Part`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Radiance {
+    /// Indexed by `Part as usize`, in [`Part::ALL`] order.
+    pub parts: [Vec3; 5],
+}
+
+impl Radiance {
+    pub fn get(&self, part: Part) -> Vec3 {
+        self.parts[part as usize]
+    }
+
+    /// The sum of all parts: the full estimate.
+    pub fn total(&self) -> Vec3 {
+        self.parts.iter().sum()
+    }
+
+    #[inline]
+    fn add(&mut self, part: Part, v: Vec3) {
+        self.parts[part as usize] += v;
+    }
+}
+
+/// What the path loop needs besides the scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PathOptions {
+    /// Longest path in bounces: emission is counted at hits after at most `max_depth`
+    /// bounces and NEE at vertices reached after fewer.
+    pub max_depth: u32,
+    /// Russian roulette applies once this many bounces have been made.
+    pub rr_depth: u32,
+    /// When false, `L S+ D ...` paths are left out: both caustic parts stay zero and
+    /// nothing else changes.
+    pub caustics: bool,
+}
+
+impl PathOptions {
+    /// Depths from the scene's `[render]` settings, caustics on.
+    pub fn from_scene(scene: &Scene) -> PathOptions {
+        let r = scene.render();
+        PathOptions {
+            max_depth: r.max_depth,
+            rr_depth: r.rr_depth,
+            caustics: true,
+        }
+    }
+}
+
+/// A scene prepared for path tracing: BSDF per material and the light sampler. Shared
+/// read-only by all render threads.
+pub struct PathTracer<'a> {
+    scene: &'a Scene,
+    bsdfs: Vec<Bsdf>,
+    lights: LightSampler,
+    opts: PathOptions,
+}
+
+/// Russian roulette never survives with a probability above this, so paths trapped between
+/// lossless mirrors still end (pbrt-v4 stops at the same value's complement in spirit).
+const MAX_SURVIVAL: f32 = 0.95;
+
+/// The shading-normal guard against light leaks (pbrt-v4 §10.1.1; Veach 1997 §5.3): a pair
+/// of directions counts as reflection (or transmission) for the BSDF, which reads the
+/// shading normal, only if the geometric normal agrees. Otherwise the pair would carry light
+/// through the surface (or stop it at the surface) where the true geometry does the opposite.
+#[inline]
+fn sides_agree(wo: Vec3, wi: Vec3, ng: Vec3, wo_l: Vec3, wi_l: Vec3) -> bool {
+    let geometric_reflection = wo.dot(ng) * wi.dot(ng) > 0.0;
+    let shading_reflection = wo_l.z * wi_l.z > 0.0;
+    geometric_reflection == shading_reflection
+}
+
+impl<'a> PathTracer<'a> {
+    pub fn new(scene: &'a Scene, opts: PathOptions) -> PathTracer<'a> {
+        PathTracer {
+            scene,
+            bsdfs: scene.materials.iter().map(bsdf_of).collect(),
+            lights: LightSampler::new(scene),
+            opts,
+        }
+    }
+
+    pub fn scene(&self) -> &Scene {
+        self.scene
+    }
+
+    pub fn lights(&self) -> &LightSampler {
+        &self.lights
+    }
+
+    pub fn options(&self) -> PathOptions {
+        self.opts
+    }
+
+    /// Radiance arriving along `-ray.d` at `ray.o`, estimated by one path whose random
+    /// numbers all come from `rng`. Every vertex draws the same seven uniforms whatever
+    /// happens there, so options that only drop contributions (caustics) never shift the
+    /// stream.
+    pub fn li(&self, ray: Ray, rng: &mut Rng) -> Radiance {
+        let geometry = &self.scene.geometry;
+        let mut out = Radiance::default();
+        let mut ray = ray;
+        let mut beta = Vec3::ONE;
+        // Non-delta vertices passed so far (the current one included once counted).
+        let mut diffuse_vertices = 0u32;
+        // Where the last bounce left and its BSDF pdf, if that bounce was non-delta: a light
+        // hit then competes with NEE and is MIS-weighted. `None` after a specular bounce.
+        let mut from_diffuse: Option<(Vec3, f32)> = None;
+        let mut bounces = 0u32;
+        while let Some(hit) = geometry.intersect(&ray) {
+            // Emission found by the path itself.
+            if let Some(light) = self.lights.light_of(hit.prim) {
+                let le = self.lights.le(light, ray.d);
+                if le != Vec3::ZERO {
+                    if diffuse_vertices == 0 {
+                        out.add(Part::Emitted, beta * le);
+                    } else if let Some((p, pdf_bsdf)) = from_diffuse {
+                        let pdf_light = self.lights.pdf(light, p, hit.point.p);
+                        let w = power_heuristic(1, pdf_bsdf, 1, pdf_light);
+                        out.add(direct_or_indirect(diffuse_vertices), beta * le * w);
+                    } else if self.opts.caustics {
+                        // Specular chain from a diffuse vertex to the light: NEE's shadow
+                        // rays cannot follow it, so BSDF sampling owns it (weight 1).
+                        let part = if diffuse_vertices == 1 {
+                            Part::Caustic
+                        } else {
+                            Part::CausticIndirect
+                        };
+                        out.add(part, beta * le);
+                    }
+                }
+            }
+            if bounces >= self.opts.max_depth {
+                break;
+            }
+
+            let u_pick = rng.uniform();
+            let u_light = rng.uniform2();
+            let u_lobe = rng.uniform();
+            let u_dir = rng.uniform2();
+            let u_rr = rng.uniform();
+
+            let bsdf = self.bsdfs[hit.material as usize];
+            let ng = hit.point.n;
+            let frame = Frame::from_z(hit.ns);
+            let wo = -ray.d.normalize();
+            let wo_l = frame.to_local(wo);
+
+            if !bsdf.is_delta() {
+                diffuse_vertices += 1;
+                if let Some(ls) = self.lights.sample(hit.point.p, u_pick, u_light) {
+                    let wi_l = frame.to_local(ls.wi);
+                    let f = bsdf.f(wo_l, wi_l, TransportMode::Radiance);
+                    if f != Vec3::ZERO
+                        && sides_agree(wo, ls.wi, ng, wo_l, wi_l)
+                        && !geometry.occluded(&hit.point.spawn_ray_to_point(&ls.point))
+                    {
+                        let w = power_heuristic(1, ls.pdf, 1, bsdf.pdf(wo_l, wi_l));
+                        let c = beta * f * ls.le * (wi_l.z.abs() * w / ls.pdf);
+                        out.add(direct_or_indirect(diffuse_vertices), c);
+                    }
+                }
+            }
+
+            let Some(s) = bsdf.sample(wo_l, u_lobe, u_dir, TransportMode::Radiance) else {
+                break;
+            };
+            let wi = frame.to_world(s.wi);
+            if !sides_agree(wo, wi, ng, wo_l, s.wi) {
+                break;
+            }
+            beta *= s.weight();
+            from_diffuse = if s.is_specular() {
+                None
+            } else {
+                Some((hit.point.p, s.pdf))
+            };
+            ray = hit.point.spawn_ray(wi);
+            bounces += 1;
+
+            if beta == Vec3::ZERO {
+                break;
+            }
+            if bounces >= self.opts.rr_depth {
+                let q = beta.max_element().min(MAX_SURVIVAL);
+                if u_rr >= q || q.is_nan() {
+                    break;
+                }
+                beta /= q;
+            }
+        }
+        out
+    }
+}
+
+#[inline]
+fn direct_or_indirect(diffuse_vertices: u32) -> Part {
+    if diffuse_vertices == 1 {
+        Part::Direct
+    } else {
+        Part::Indirect
+    }
+}

@@ -1,0 +1,116 @@
+//! Parallel rendering over tiles into a film with one layer per [`Part`].
+
+use crate::{Part, PathOptions, PathTracer};
+use film::{Film, TileBuffer, tiles};
+use math::Rng;
+use rayon::prelude::*;
+use scene::Scene;
+
+/// Settings of one eye pass. Path depths come from the scene's `[render]` settings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderOptions {
+    /// Samples per pixel (box-filtered, jittered within the pixel).
+    pub spp: u32,
+    /// Include `L S+ D ...` paths (the two caustic layers); see [`PathOptions::caustics`].
+    pub caustics: bool,
+    /// Worker threads; `None` uses rayon's global pool. Does not change the image.
+    pub threads: Option<usize>,
+    /// Tile edge in pixels. Does not change the image.
+    pub tile: u32,
+}
+
+impl RenderOptions {
+    /// `spp` and `tile` from the scene's `[render]` settings, caustics on, global pool.
+    pub fn from_scene(scene: &Scene) -> RenderOptions {
+        let r = scene.render();
+        RenderOptions {
+            spp: r.spp,
+            caustics: true,
+            threads: None,
+            tile: r.tile,
+        }
+    }
+}
+
+/// Renders the scene from its camera into a film with the layers named by [`Part::name`], in
+/// [`Part::ALL`] order. Each layer holds per-pixel sums of sample contributions (and the
+/// sample count as weight): resolve with `Normalize::Constant(spp)` (or `Normalize::Weight`).
+///
+/// The film is bit-identical for any `threads` and `tile`: pixel sample `s` of pixel
+/// `p = y * width + x` uses `Rng::for_index(scene.seed(), p * spp + s)`, each pixel's samples
+/// are summed in order in one tile buffer, and each pixel receives exactly one merge.
+///
+/// `progress` is called once per finished tile with the number of samples that tile took
+/// (an increment, not a running total), from worker threads.
+///
+/// # Panics
+/// If `opts.spp` or `opts.tile` is zero, or a thread pool cannot be built.
+pub fn render(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) + Sync)) -> Film {
+    assert!(opts.spp > 0, "render: spp must be positive");
+    assert!(opts.tile > 0, "render: tile must be positive");
+    let tracer = PathTracer::new(
+        scene,
+        PathOptions {
+            caustics: opts.caustics,
+            ..PathOptions::from_scene(scene)
+        },
+    );
+    let (width, height) = (scene.camera.width as usize, scene.camera.height as usize);
+    let mut film = Film::new(width, height);
+    // All layers exist before tiles are handed out, so every tile has them in the same order.
+    for part in Part::ALL {
+        film.layer_mut(part.name());
+    }
+    let rects = tiles(width, height, opts.tile as usize);
+    let work = || -> Vec<TileBuffer> {
+        rects
+            .par_iter()
+            .map(|&rect| {
+                let buf = render_tile(&tracer, &film, rect, opts.spp);
+                progress(rect.area() as u64 * opts.spp as u64);
+                buf
+            })
+            .collect()
+    };
+    let buffers = match opts.threads {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .expect("render: cannot build the thread pool")
+            .install(work),
+        None => work(),
+    };
+    // `collect` keeps tile order; merging in that order is deterministic (and, since tiles
+    // partition the image, the order would not matter anyway).
+    for buf in &buffers {
+        film.merge_tile(buf);
+    }
+    film
+}
+
+fn render_tile(tracer: &PathTracer, film: &Film, rect: film::Rect, spp: u32) -> TileBuffer {
+    let scene = tracer.scene();
+    let seed = scene.seed();
+    let width = film.width();
+    let mut buf = film.tile_buffer(rect);
+    for y in rect.y0..rect.y1 {
+        for x in rect.x0..rect.x1 {
+            let pixel = (y * width + x) as u64;
+            for s in 0..spp as u64 {
+                let mut rng = Rng::for_index(seed, pixel * spp as u64 + s);
+                let [jx, jy] = rng.uniform2();
+                let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
+                let l = tracer.li(ray, &mut rng);
+                for part in Part::ALL {
+                    let layer = buf.layer_mut(part.name());
+                    let v = l.get(part);
+                    if v != glam::Vec3::ZERO {
+                        layer.add(x, y, v.to_array());
+                    }
+                    layer.add_weight(x, y, 1.0);
+                }
+            }
+        }
+    }
+    buf
+}
