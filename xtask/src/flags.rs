@@ -7,6 +7,10 @@ cargo xtask <command>
                       single-thread rays/s: 1M coherent camera rays and 1M incoherent rays
                       (default scene: scenes/cornell-spheres/tessellated.toml);
                       --compare also measures the binary BVH (Bvh2) next to CwBvh
+  render SCENE --method path [--spp N] [--no-caustics] [--threads N] [--out DIR]
+                      render with a progress bar; writes image.exr, image.png, layers/, image.json
+  compare A.exr B.exr [--mask x0,y0,x1,y1]
+                      RMSE, relative MSE and mean absolute error of A against reference B
   info SCENE          load a scene and print what it holds
   gen-scenes          rewrite the generated OBJ/MTL files under scenes/
 ";
@@ -27,8 +31,8 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
     match a.as_slice() {
         [] | ["help" | "-h" | "--help", ..] => Ok(Cmd::Help),
         ["gen-scenes"] => Ok(Cmd::GenScenes),
-        ["info", rest @ ..] => Ok(Cmd::Photonflow(
-            std::iter::once("info")
+        [cmd @ ("info" | "render" | "compare"), rest @ ..] => Ok(Cmd::Photonflow(
+            std::iter::once(*cmd)
                 .chain(rest.iter().copied())
                 .map(String::from)
                 .collect(),

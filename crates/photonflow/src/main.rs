@@ -3,6 +3,8 @@
 //! nothing here panics on bad input.
 
 mod bench;
+mod progress;
+mod render;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -32,6 +34,43 @@ enum Cmd {
         #[arg(long)]
         compare: bool,
     },
+    /// Render an image. `--method path` is the path-traced reference.
+    Render {
+        scene: PathBuf,
+        #[arg(long, default_value = "path")]
+        method: String,
+        /// Samples per pixel (default: the scene file's render.spp).
+        #[arg(long)]
+        spp: Option<u32>,
+        /// Leave out L S+ D paths (caustics) so a caustic layer made elsewhere can be added.
+        #[arg(long)]
+        no_caustics: bool,
+        /// Worker threads (default: all cores). The image does not depend on it.
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Output directory (default: out/<scene dir>-<scene stem>-<method>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Exposure of the PNG in stops.
+        #[arg(long, default_value_t = 0.0)]
+        exposure: f32,
+    },
+    /// Error metrics of image A against reference B (linear EXR files).
+    Compare {
+        a: PathBuf,
+        b: PathBuf,
+        /// Restrict to the pixel rectangle x0,y0,x1,y1 (half open).
+        #[arg(long, value_parser = parse_rect)]
+        mask: Option<[usize; 4]>,
+    },
+}
+
+fn parse_rect(s: &str) -> Result<[usize; 4], String> {
+    let v: Vec<usize> = s
+        .split(',')
+        .map(|t| t.trim().parse::<usize>().map_err(|e| format!("`{t}`: {e}")))
+        .collect::<Result<_, _>>()?;
+    <[usize; 4]>::try_from(v).map_err(|_| "expected x0,y0,x1,y1".to_string())
 }
 
 fn main() -> ExitCode {
@@ -61,6 +100,26 @@ fn run(cmd: Cmd) -> Result<(), String> {
             rays,
             compare,
         } => bench::rays(&scene, runs, rays, compare),
+        Cmd::Render {
+            scene,
+            method,
+            spp,
+            no_caustics,
+            threads,
+            out,
+            exposure,
+        } => match method.as_str() {
+            "path" => render::path(render::RenderArgs {
+                scene,
+                spp,
+                no_caustics,
+                threads,
+                out,
+                exposure,
+            }),
+            other => Err(format!("unknown --method `{other}` (known: path)")),
+        },
+        Cmd::Compare { a, b, mask } => render::compare(&a, &b, mask),
     }
 }
 

@@ -103,7 +103,12 @@ pub fn path(a: RenderArgs) -> Result<(), String> {
         h,
         samples as f64 / secs / 1e6
     );
-    println!("wrote {} (linear), {} (gamma {}), layers/ and image.json", exr.display(), png.display(), tone.gamma);
+    println!(
+        "wrote {} (linear), {} (gamma {}), layers/ and image.json",
+        exr.display(),
+        png.display(),
+        tone.gamma
+    );
     Ok(())
 }
 

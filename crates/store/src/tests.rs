@@ -27,7 +27,12 @@ fn octahedral_directions_round_trip_within_1e_4_radians() {
 
 #[test]
 fn a_photon_is_32_bytes_and_keeps_its_fields() {
-    let p = Photon::new(Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.5, 0.25, 0.125), -Vec3::Y, 7);
+    let p = Photon::new(
+        Vec3::new(1.0, 2.0, 3.0),
+        Vec3::new(0.5, 0.25, 0.125),
+        -Vec3::Y,
+        7,
+    );
     assert_eq!(bytemuck::bytes_of(&p).len(), 32);
     assert_eq!(p.position(), Vec3::new(1.0, 2.0, 3.0));
     assert_eq!(p.power(), Vec3::new(0.5, 0.25, 0.125));
