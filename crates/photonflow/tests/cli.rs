@@ -149,3 +149,75 @@ fn bad_inputs_fail_cleanly() {
         "absurd",
     );
 }
+
+fn photonflow(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_photonflow"))
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn render_writes_exr_png_layers_and_json_identically_for_any_thread_count() {
+    let dir = Scratch::new("render", &[]);
+    let out1 = dir.0.join("t1");
+    let out2 = dir.0.join("t2");
+    for (out, threads) in [(&out1, "1"), (&out2, "2")] {
+        let o = photonflow(&[
+            "render",
+            "scenes/cornell-spheres/analytic.toml",
+            "--spp",
+            "2",
+            "--threads",
+            threads,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    for f in [
+        "image.exr",
+        "image.png",
+        "image.json",
+        "layers/direct.exr",
+        "layers/caustic.exr",
+    ] {
+        let a = std::fs::read(out1.join(f)).unwrap();
+        if f.ends_with(".exr") || f.ends_with(".png") {
+            assert_eq!(
+                a,
+                std::fs::read(out2.join(f)).unwrap(),
+                "{f} differs between 1 and 2 threads"
+            );
+        }
+    }
+    let json = std::fs::read_to_string(out1.join("image.json")).unwrap();
+    for key in [
+        "\"spp\": 2",
+        "\"samples_per_s\"",
+        "\"time_s\"",
+        "\"scene_hash\"",
+        "\"threads\": 1",
+    ] {
+        assert!(json.contains(key), "{key} missing from {json}");
+    }
+    // An image compared with itself has zero error.
+    let exr = out1.join("image.exr");
+    let o = photonflow(&["compare", exr.to_str().unwrap(), exr.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success() && text.contains("rmse=0.000000e0 "),
+        "{text}"
+    );
+}
+
+#[test]
+fn compare_refuses_missing_files_and_bad_masks() {
+    let o = photonflow(&["compare", "nope-a.exr", "nope-b.exr"]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(e.contains("nope-a.exr") && !e.contains("panicked"), "{e}");
+    let o = photonflow(&["compare", "a.exr", "b.exr", "--mask", "1,2,3"]);
+    assert_eq!(o.status.code(), Some(2), "usage error");
+}
