@@ -24,10 +24,12 @@
 
 mod light;
 mod path;
+mod photon;
 mod render;
 
 pub use light::{LightSample, LightSampler};
 pub use path::{Part, PathOptions, PathTracer, Radiance, bsdf_of};
+pub use photon::{Irradiance, MapLookup, PhotonMethod, render_photon_map};
 pub use render::{RenderOptions, render};
 
 #[cfg(test)]

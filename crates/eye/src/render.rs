@@ -44,10 +44,8 @@ impl RenderOptions {
 /// (an increment, not a running total), from worker threads.
 ///
 /// # Panics
-/// If `opts.spp` or `opts.tile` is zero, or a thread pool cannot be built.
+/// If `opts.spp` or `opts.tile` is zero (callers validate settings first).
 pub fn render(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) + Sync)) -> Film {
-    assert!(opts.spp > 0, "render: spp must be positive");
-    assert!(opts.tile > 0, "render: tile must be positive");
     let tracer = PathTracer::new(
         scene,
         PathOptions {
@@ -55,29 +53,48 @@ pub fn render(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) + Syn
             ..PathOptions::from_scene(scene)
         },
     );
+    let names = Part::ALL.map(Part::name);
+    render_layers(scene, opts, names, progress, &|ray, rng| {
+        let l = tracer.li(ray, rng);
+        Part::ALL.map(|p| l.get(p))
+    })
+}
+
+/// The tile machinery shared by every eye-pass method: one film layer per entry of `names`,
+/// pixel sample `s` of pixel `p` drawing from `Rng::for_index(seed, p * spp + s)` (after two
+/// numbers for the pixel jitter), `sample` returning one contribution per layer.
+pub(crate) fn render_layers<const N: usize>(
+    scene: &Scene,
+    opts: &RenderOptions,
+    names: [&str; N],
+    progress: &(dyn Fn(u64) + Sync),
+    sample: &(dyn Fn(geom::Ray, &mut Rng) -> [glam::Vec3; N] + Sync),
+) -> Film {
+    assert!(opts.spp > 0, "render: spp must be positive");
+    assert!(opts.tile > 0, "render: tile must be positive");
     let (width, height) = (scene.camera.width as usize, scene.camera.height as usize);
     let mut film = Film::new(width, height);
     // All layers exist before tiles are handed out, so every tile has them in the same order.
-    for part in Part::ALL {
-        film.layer_mut(part.name());
+    for name in names {
+        film.layer_mut(name);
     }
     let rects = tiles(width, height, opts.tile as usize);
     let work = || -> Vec<TileBuffer> {
         rects
             .par_iter()
             .map(|&rect| {
-                let buf = render_tile(&tracer, &film, rect, opts.spp);
+                let buf = render_tile(scene, &film, rect, opts.spp, names, sample);
                 progress(rect.area() as u64 * opts.spp as u64);
                 buf
             })
             .collect()
     };
     let buffers = match opts.threads {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .expect("render: cannot build the thread pool")
-            .install(work),
+        Some(n) => match rayon::ThreadPoolBuilder::new().num_threads(n).build() {
+            Ok(pool) => pool.install(work),
+            // No pool (resource limits): the global one gives the same image.
+            Err(_) => work(),
+        },
         None => work(),
     };
     // `collect` keeps tile order; merging in that order is deterministic (and, since tiles
@@ -88,27 +105,34 @@ pub fn render(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) + Syn
     film
 }
 
-fn render_tile(tracer: &PathTracer, film: &Film, rect: film::Rect, spp: u32) -> TileBuffer {
-    let scene = tracer.scene();
+fn render_tile<const N: usize>(
+    scene: &Scene,
+    film: &Film,
+    rect: film::Rect,
+    spp: u32,
+    names: [&str; N],
+    sample: &(dyn Fn(geom::Ray, &mut Rng) -> [glam::Vec3; N] + Sync),
+) -> TileBuffer {
     let seed = scene.seed();
     let width = film.width();
     let mut buf = film.tile_buffer(rect);
     for y in rect.y0..rect.y1 {
         for x in rect.x0..rect.x1 {
             let pixel = (y * width + x) as u64;
+            let mut sums = [glam::DVec3::ZERO; N];
             for s in 0..spp as u64 {
                 let mut rng = Rng::for_index(seed, pixel * spp as u64 + s);
                 let [jx, jy] = rng.uniform2();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
-                let l = tracer.li(ray, &mut rng);
-                for part in Part::ALL {
-                    let layer = buf.layer_mut(part.name());
-                    let v = l.get(part);
-                    if v != glam::Vec3::ZERO {
-                        layer.add(x, y, v.to_array());
-                    }
-                    layer.add_weight(x, y, 1.0);
+                let l = sample(ray, &mut rng);
+                for (sum, v) in sums.iter_mut().zip(l) {
+                    *sum += v.as_dvec3();
                 }
+            }
+            for (name, sum) in names.iter().zip(sums) {
+                let layer = buf.layer_mut(name);
+                layer.add_f64(x, y, sum.to_array());
+                layer.add_weight(x, y, spp as f64);
             }
         }
     }

@@ -122,6 +122,15 @@ impl Layer {
         }
     }
 
+    /// Adds an already-summed f64 value (a pixel's samples summed by the caller, in f64).
+    pub fn add_f64(&mut self, x: usize, y: usize, rgb: [f64; 3]) {
+        let i = self.index(x, y);
+        let s = &mut self.sum[i];
+        for c in 0..3 {
+            s[c] += rgb[c];
+        }
+    }
+
     /// Adds `w` to the pixel's weight (sample count, or filter weight).
     pub fn add_weight(&mut self, x: usize, y: usize, w: f64) {
         let i = self.index(x, y);

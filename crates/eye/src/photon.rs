@@ -1,0 +1,216 @@
+//! Eye passes that read photon maps: the global map visualised directly, and the course
+//! framework's standard (next-event estimation for direct light, the caustic map, and final
+//! gathering into the global map; Jensen 2001, §9.3 "Rendering"). The maps themselves belong
+//! to the density stage; this module sees them only through [`Irradiance`], so `eye` and
+//! `density` stay independent of each other.
+
+use crate::render::render_layers;
+use crate::{LightSampler, RenderOptions, bsdf_of};
+use bsdf::{Bsdf, TransportMode};
+use film::Film;
+use geom::{Hit, Ray};
+use glam::Vec3;
+use math::{Frame, Rng, warp};
+use scene::{Material, Scene};
+
+/// Which photon map a lookup reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MapLookup {
+    Global,
+    Caustic,
+}
+
+/// Irradiance estimates from photon maps, supplied by the caller.
+pub trait Irradiance: Sync {
+    /// Irradiance at `p` on a surface whose unit normal `n` faces the side light is gathered
+    /// from.
+    fn irradiance(&self, map: MapLookup, p: Vec3, n: Vec3) -> Vec3;
+}
+
+/// How photon maps are turned into an image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PhotonMethod {
+    /// Radiance at the first diffuse vertex seen from the eye (through mirrors and glass) is
+    /// `rho / pi * E_global`: the global map shown directly, no final gathering.
+    GlobalDirect,
+    /// Direct light by next-event estimation, caustics from the caustic map, indirect light by
+    /// `rays` final-gather rays per sample that read the global map where they land.
+    FinalGather { rays: u32 },
+}
+
+impl PhotonMethod {
+    /// Film layers this method writes, in order; their sum is the image.
+    pub fn layers(self) -> &'static [&'static str] {
+        match self {
+            PhotonMethod::GlobalDirect => &["emitted", "global"],
+            PhotonMethod::FinalGather { .. } => &["emitted", "direct", "caustic", "indirect"],
+        }
+    }
+}
+
+/// Renders with photon-map estimates; see [`PhotonMethod`] for the layers. Deterministic for
+/// any thread count, like [`crate::render`].
+pub fn render_photon_map(
+    scene: &Scene,
+    opts: &RenderOptions,
+    method: PhotonMethod,
+    maps: &dyn Irradiance,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Film {
+    let ctx = Ctx {
+        scene,
+        bsdfs: scene.materials.iter().map(bsdf_of).collect(),
+        lights: LightSampler::new(scene),
+        maps,
+        max_depth: scene.render().max_depth,
+    };
+    match method {
+        PhotonMethod::GlobalDirect => {
+            render_layers(scene, opts, ["emitted", "global"], progress, &|ray, rng| {
+                let (emitted, first) = ctx.to_diffuse(ray, rng, true);
+                let global = first.map_or(Vec3::ZERO, |v| {
+                    v.beta * v.albedo / std::f32::consts::PI
+                        * maps.irradiance(MapLookup::Global, v.hit.point.p, v.n)
+                });
+                [emitted, global]
+            })
+        }
+        PhotonMethod::FinalGather { rays } => render_layers(
+            scene,
+            opts,
+            ["emitted", "direct", "caustic", "indirect"],
+            progress,
+            &|ray, rng| {
+                let (emitted, first) = ctx.to_diffuse(ray, rng, true);
+                let Some(v) = first else {
+                    return [emitted, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO];
+                };
+                let brdf = v.beta * v.albedo / std::f32::consts::PI;
+                let direct = ctx.direct(&v, rng) * brdf;
+                let caustic = brdf * maps.irradiance(MapLookup::Caustic, v.hit.point.p, v.n);
+                let indirect = ctx.gather(&v, rays, rng) * (v.beta * v.albedo);
+                [emitted, direct, caustic, indirect]
+            },
+        ),
+    }
+}
+
+/// The first diffuse vertex of an eye path.
+struct Vertex {
+    hit: Hit,
+    /// Shading normal turned towards the incoming ray.
+    n: Vec3,
+    albedo: Vec3,
+    /// Throughput of the specular chain that led here.
+    beta: Vec3,
+}
+
+struct Ctx<'a> {
+    scene: &'a Scene,
+    bsdfs: Vec<Bsdf>,
+    lights: LightSampler,
+    maps: &'a dyn Irradiance,
+    max_depth: u32,
+}
+
+impl Ctx<'_> {
+    /// Follows `ray` through specular surfaces (Fresnel-chosen at glass) to the first diffuse
+    /// vertex. Returns emission seen on the way (only when `count_emission`) and the vertex.
+    fn to_diffuse(
+        &self,
+        mut ray: Ray,
+        rng: &mut Rng,
+        count_emission: bool,
+    ) -> (Vec3, Option<Vertex>) {
+        let mut beta = Vec3::ONE;
+        let mut emitted = Vec3::ZERO;
+        for _ in 0..=self.max_depth {
+            let Some(hit) = self.scene.geometry.intersect(&ray) else {
+                break;
+            };
+            if count_emission && let Some(light) = self.lights.light_of(hit.prim) {
+                emitted += beta * self.lights.le(light, ray.d);
+            }
+            let wo = -ray.d.normalize();
+            let (u_lobe, u_dir) = (rng.uniform(), rng.uniform2());
+            match &self.scene.materials[hit.material as usize] {
+                Material::Lambertian { albedo } => {
+                    // Shading normals face the geometric one (geom), so this turns both to
+                    // the side the ray came from.
+                    let n = if wo.dot(hit.point.n) >= 0.0 {
+                        hit.ns
+                    } else {
+                        -hit.ns
+                    };
+                    return (
+                        emitted,
+                        Some(Vertex {
+                            hit,
+                            n,
+                            albedo: *albedo,
+                            beta,
+                        }),
+                    );
+                }
+                _ => {
+                    let frame = Frame::from_z(hit.ns);
+                    let bsdf = self.bsdfs[hit.material as usize];
+                    let Some(s) =
+                        bsdf.sample(frame.to_local(wo), u_lobe, u_dir, TransportMode::Radiance)
+                    else {
+                        break;
+                    };
+                    beta *= s.weight();
+                    if beta == Vec3::ZERO {
+                        break;
+                    }
+                    ray = hit.point.spawn_ray(frame.to_world(s.wi));
+                }
+            }
+        }
+        (emitted, None)
+    }
+
+    /// Irradiance at the vertex from the lights by one shadow ray (next-event estimation).
+    fn direct(&self, v: &Vertex, rng: &mut Rng) -> Vec3 {
+        let (u_pick, u) = (rng.uniform(), rng.uniform2());
+        let Some(ls) = self.lights.sample(v.hit.point.p, u_pick, u) else {
+            return Vec3::ZERO;
+        };
+        let cos = ls.wi.dot(v.n);
+        if cos <= 0.0 || ls.wi.dot(v.hit.point.n) * v.n.dot(v.hit.point.n) <= 0.0 {
+            return Vec3::ZERO;
+        }
+        if self
+            .scene
+            .geometry
+            .occluded(&v.hit.point.spawn_ray_to_point(&ls.point))
+        {
+            return Vec3::ZERO;
+        }
+        ls.le * (cos / ls.pdf)
+    }
+
+    /// Mean radiance arriving at the vertex over `rays` cosine-distributed gather rays, read
+    /// from the global map where they land (emission excluded: next-event estimation owns it).
+    /// Times `albedo` this is the indirect radiance (the cosine pdf cancels `cos / pi`).
+    fn gather(&self, v: &Vertex, rays: u32, rng: &mut Rng) -> Vec3 {
+        if rays == 0 {
+            return Vec3::ZERO;
+        }
+        let frame = Frame::from_z(v.n);
+        let mut sum = glam::DVec3::ZERO;
+        for _ in 0..rays {
+            let wi = frame.to_world(warp::sample_cosine_hemisphere(rng.uniform2()));
+            if wi.dot(v.hit.point.n) * v.n.dot(v.hit.point.n) <= 0.0 {
+                continue;
+            }
+            let ray = v.hit.point.spawn_ray(wi);
+            if let (_, Some(y)) = self.to_diffuse(ray, rng, false) {
+                let e = self.maps.irradiance(MapLookup::Global, y.hit.point.p, y.n);
+                sum += (y.beta * y.albedo / std::f32::consts::PI * e).as_dvec3();
+            }
+        }
+        (sum / rays as f64).as_vec3()
+    }
+}
