@@ -57,7 +57,7 @@ impl LightSampler {
             .collect();
         let weights: Vec<f64> = lights.iter().map(|l| l.power.element_sum()).collect();
         let sum: f64 = weights.iter().sum();
-        if lights.is_empty() || !(sum > 0.0) || !sum.is_finite() {
+        if lights.is_empty() || !sum.is_finite() || sum <= 0.0 {
             return None;
         }
         for (l, w) in lights.iter_mut().zip(&weights) {

@@ -1,8 +1,7 @@
 //! The effects plan: which photon sets a run needs, decided from the scene before tracing.
 
-use crate::EmitParams;
+use crate::{EmitParams, LightSampler};
 use geom::Prim;
-use glam::DVec3;
 use scene::{Material, Scene};
 use serde::Serialize;
 use std::fmt;
@@ -58,15 +57,13 @@ impl Plan {
     /// - no light → [`PlanError::NoLight`] (scene loading refuses such scenes today; the plan
     ///   does not rely on it).
     pub fn for_scene(scene: &Scene, params: &EmitParams) -> Result<Plan, PlanError> {
-        let power = scene
-            .lights
-            .iter()
-            .fold(DVec3::ZERO, |s, l| s + l.power.as_dvec3());
-        if scene.lights.is_empty() || !(power.max_element() > 0.0) {
+        // The sampler decides what counts as a light, so plan and tracer cannot disagree.
+        let Some(lights) = LightSampler::new(scene) else {
             return Err(PlanError::NoLight {
                 scene: scene.file.name.clone(),
             });
-        }
+        };
+        let power = lights.total_power();
         if params.photons == 0 {
             return Err(PlanError::NoPhotons);
         }

@@ -4,6 +4,7 @@ use crate::plan::{is_diffuse, prim_id};
 use crate::{EmitParams, LightSampler, Plan};
 use bsdf::{Bsdf, Dielectric, Lambertian, Metal, Mirror, TransportMode};
 use geom::Prim;
+use glam::Vec3;
 use math::{Frame, Rng};
 use rayon::prelude::*;
 use scene::{Material, Scene};
@@ -69,12 +70,7 @@ pub fn chunks(total: u64, chunk: u64) -> impl Iterator<Item = Range<u64>> {
 ///
 /// A path also ends when nothing it can still do reaches a planned set: a diffuse bounce when
 /// only the caustic set is planned, everything when neither is.
-pub fn trace_range(
-    scene: &Scene,
-    params: &EmitParams,
-    plan: &Plan,
-    range: Range<u64>,
-) -> Traced {
+pub fn trace_range(scene: &Scene, params: &EmitParams, plan: &Plan, range: Range<u64>) -> Traced {
     let mut out = Traced {
         emitted: range.end.saturating_sub(range.start),
         ..Traced::default()
@@ -147,6 +143,10 @@ impl Tracer<'_> {
         let mut specular_bounces = 0u32;
         let mut diffuse_bounces = 0u32;
         for hit_index in 0..self.params.max_depth {
+            // Black photons (a channel-less mirror, say) carry nothing; NaN fails this too.
+            if !flux.cmpgt(Vec3::ZERO).any() {
+                return;
+            }
             let Some(hit) = self.scene.geometry.intersect(&ray) else {
                 return;
             };
@@ -168,7 +168,7 @@ impl Tracer<'_> {
                     return;
                 }
                 let survive = (albedo * flux).max_element() / flux.max_element();
-                if !(uc < survive) {
+                if uc >= survive {
                     return;
                 }
                 flux = flux * albedo / survive;
@@ -199,9 +199,6 @@ impl Tracer<'_> {
             if s.is_specular() {
                 flux *= s.weight();
                 specular_bounces += 1;
-            }
-            if !(flux.max_element() > 0.0) {
-                return;
             }
             ray = hit.point.spawn_ray(wi);
         }
