@@ -61,6 +61,11 @@ pub fn chunks(total: u64, chunk: u64) -> impl Iterator<Item = Range<u64>> {
 /// - specular: `Φ *= f |cos θi| / pdf` of a [`TransportMode::Importance`] sample;
 /// - black Lambertian: absorbed.
 ///
+/// No adjoint shading-normal correction is applied (Veach 1997 §5.3): like pbrt-v4's SPPM
+/// photon pass (§16.2), the throughput uses the shading-frame cosine only. It matters only
+/// for interpolated normals (the tessellated spheres, which are specular: there
+/// `f |cos| / pdf` is the reflectance or 1 either way).
+///
 /// Russian roulette survival is `P = max_c(ρ_c Φ_c) / max_c(Φ_c)` (Jensen 2001 ch. 5; the
 /// albedo's largest component for a white photon), survivors carry `Φ ρ / P`, whose largest
 /// component equals the incoming one: photon power never grows, so a few bright photons cannot
@@ -163,8 +168,9 @@ impl Tracer<'_> {
                 if self.plan.caustic && specular_bounces > 0 && diffuse_bounces == 0 {
                     out.caustic.push(photon());
                 }
-                // Past a diffuse bounce only the global set can gain photons.
-                if !self.plan.global {
+                // Past a diffuse bounce only the global set can gain photons; past the last
+                // hit, nothing.
+                if !self.plan.global || hit_index + 1 == self.params.max_depth {
                     return;
                 }
                 let survive = (albedo * flux).max_element() / flux.max_element();
