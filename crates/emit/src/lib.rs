@@ -1,0 +1,42 @@
+//! `emit`: photons from the scene's area lights, traced through it and stored on diffuse
+//! surfaces (Jensen 2001, "Realistic Image Synthesis Using Photon Mapping", ch. 5–6).
+//!
+//! Key decision: **photon `i` is a pure function of `(scene seed, i)`**. Its random numbers
+//! come from [`math::Rng::for_index`] and nothing it does depends on any other photon, so
+//! [`trace_range`] over consecutive ranges, concatenated, equals one big range bit for bit,
+//! whatever the thread count and chunk size (style anchor A1.8, pbrt-v4's SPPM photon
+//! indexing). Workers therefore need no shared state and no ordering beyond "concatenate
+//! chunks in index order".
+//!
+//! Second decision: an **effects plan** ([`Plan`]) is made from the scene before any photon
+//! is traced. A set no surface can produce is not traced at all (no specular surface → no
+//! caustic set; no diffuse surface → no global set), and a path stops as soon as it can no
+//! longer add to a planned set, so a caustic-only run ends every path at its first diffuse hit.
+//!
+//! Estimators normalise by the number of photon *paths emitted*, never by the number stored:
+//! [`Traced::emitted`] carries it next to the photons (style anchor C).
+//!
+//! Tracing rules (the whole contract, see [`trace_range`]):
+//! - emission: a light triangle chosen with probability ∝ its power (summed over RGB), a point
+//!   uniform on it, a cosine-weighted direction about its normal (one-sided); flux
+//!   `Φ_i / (p_i N)`, which is `Φ_total / N` for power-proportional choice (Jensen 2001
+//!   §5.1, multiple lights);
+//! - diffuse hit (Lambertian, albedo > 0): store, then Russian roulette with survival
+//!   `P = max(ρ·Φ) / max(Φ)` (Jensen 2001 ch. 5, Russian roulette), survivors carry
+//!   `Φ ρ / P`;
+//! - specular hit (mirror, metal, glass): sample the BSDF in `TransportMode::Importance`,
+//!   `Φ *= f |cos θ| / pdf` (glass: Fresnel-chosen reflection or refraction, weight 1);
+//! - black surfaces absorb; a path ends on escape or after [`EmitParams::max_depth`] hits.
+
+mod light;
+mod params;
+mod plan;
+mod trace;
+
+pub use light::{Emitted, LightSampler};
+pub use params::EmitParams;
+pub use plan::{Plan, PlanError};
+pub use trace::{EMIT_STREAM, SPHERE_BIT, Traced, chunks, surface_id, trace_parallel, trace_range};
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,167 @@
+//! The effects plan: which photon sets a run needs, decided from the scene before tracing.
+
+use crate::{EmitParams, LightSampler};
+use geom::Prim;
+use scene::{Material, Scene};
+use serde::Serialize;
+use std::fmt;
+
+/// Which photon sets a run traces, and why. Printed before a run and saved with its outputs
+/// (it is `Serialize`), so a missing caustic map is explained, not discovered.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Plan {
+    /// Trace the global set (photons at every diffuse hit).
+    pub global: bool,
+    /// Trace the caustic set (photons at the first diffuse hit of L S+ D paths).
+    pub caustic: bool,
+    /// One line per set: traced or skipped, and the reason.
+    pub reasons: Vec<String>,
+    /// Number of emitting triangles.
+    pub lights: usize,
+    /// Total emitted power, RGB.
+    pub power: [f64; 3],
+    /// Photon paths to emit.
+    pub photons: u64,
+}
+
+/// A run that cannot be planned.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PlanError {
+    /// No emitting triangle, or lights whose total power is zero: no photon can be emitted.
+    NoLight { scene: String },
+    /// `photons = 0`: the flux `Φ / N` is undefined.
+    NoPhotons,
+}
+
+impl fmt::Display for PlanError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PlanError::NoLight { scene } => write!(
+                f,
+                "scene `{scene}` has no light with positive power: no photon can be emitted \
+                 (give some triangle's material an emission)"
+            ),
+            PlanError::NoPhotons => write!(f, "photons = 0: emit at least one photon path"),
+        }
+    }
+}
+
+impl std::error::Error for PlanError {}
+
+impl Plan {
+    /// Decide the photon sets from the materials the scene's primitives actually use.
+    /// Specular: mirror, metal or dielectric. Diffuse: Lambertian with a non-zero albedo (a
+    /// black surface reflects nothing, so photons stored there could never be seen).
+    /// - no diffuse surface → no global set, and no caustic set (nowhere to store it);
+    /// - no specular surface → no caustic set (no path can be L S+ D);
+    /// - no light → [`PlanError::NoLight`] (scene loading refuses such scenes today; the plan
+    ///   does not rely on it).
+    pub fn for_scene(scene: &Scene, params: &EmitParams) -> Result<Plan, PlanError> {
+        // The sampler decides what counts as a light, so plan and tracer cannot disagree.
+        let Some(lights) = LightSampler::new(scene) else {
+            return Err(PlanError::NoLight {
+                scene: scene.file.name.clone(),
+            });
+        };
+        let power = lights.total_power();
+        if params.photons == 0 {
+            return Err(PlanError::NoPhotons);
+        }
+
+        let geometry = &scene.geometry;
+        let mut used = vec![false; scene.materials.len()];
+        for &m in &geometry.mesh().materials {
+            used[m as usize] = true;
+        }
+        for s in geometry.spheres() {
+            used[s.material as usize] = true;
+        }
+        let names = |pred: &dyn Fn(&Material) -> bool| -> Vec<&str> {
+            scene
+                .materials
+                .iter()
+                .zip(&scene.material_names)
+                .zip(&used)
+                .filter(|((m, _), u)| **u && pred(m))
+                .map(|((_, n), _)| n.as_str())
+                .collect()
+        };
+        let diffuse = names(&is_diffuse);
+        let specular = names(&Material::is_specular);
+
+        let mut reasons = Vec::new();
+        let global = params.global && !diffuse.is_empty();
+        reasons.push(if !params.global {
+            "global photons: skipped (not requested)".to_string()
+        } else if diffuse.is_empty() {
+            "global photons: skipped (no diffuse surface in the scene)".to_string()
+        } else {
+            format!(
+                "global photons: traced (diffuse surfaces: {}; direct hits {})",
+                diffuse.join(", "),
+                if params.store_direct {
+                    "stored"
+                } else {
+                    "not stored"
+                }
+            )
+        });
+        let caustic = params.caustic && !specular.is_empty() && !diffuse.is_empty();
+        reasons.push(if !params.caustic {
+            "caustic photons: skipped (not requested)".to_string()
+        } else if specular.is_empty() {
+            "caustic photons: skipped (no specular surface in the scene)".to_string()
+        } else if diffuse.is_empty() {
+            "caustic photons: skipped (no diffuse surface to store them on)".to_string()
+        } else {
+            format!(
+                "caustic photons: traced (specular surfaces: {})",
+                specular.join(", ")
+            )
+        });
+        if !global && !caustic {
+            reasons.push("photon tracing: skipped (no photon set to fill)".to_string());
+        }
+        Ok(Plan {
+            global,
+            caustic,
+            reasons,
+            lights: scene.lights.len(),
+            power: power.to_array(),
+            photons: params.photons,
+        })
+    }
+
+    /// True when no photon set is traced at all.
+    pub fn is_empty(&self) -> bool {
+        !self.global && !self.caustic
+    }
+}
+
+/// A material photons are stored on: Lambertian and not black.
+pub(crate) fn is_diffuse(m: &Material) -> bool {
+    matches!(m, Material::Lambertian { albedo } if albedo.max_element() > 0.0)
+}
+
+/// The surface id a photon records: the triangle id, or the sphere id with the top bit set.
+pub(crate) fn prim_id(prim: Prim) -> u32 {
+    match prim {
+        Prim::Triangle(i) => i,
+        Prim::Sphere(i) => i | crate::SPHERE_BIT,
+    }
+}
+
+impl fmt::Display for Plan {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let [r, g, b] = self.power;
+        writeln!(
+            f,
+            "effects plan: {} photon paths from {} light triangle(s), total power ({r:.4}, {g:.4}, {b:.4})",
+            self.photons, self.lights
+        )?;
+        for line in &self.reasons {
+            writeln!(f, "  {line}")?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,212 @@
+//! Photon tracing: paths from the lights, stored at diffuse hits.
+
+use crate::plan::{is_diffuse, prim_id};
+use crate::{EmitParams, LightSampler, Plan};
+use bsdf::{Bsdf, Dielectric, Lambertian, Metal, Mirror, TransportMode};
+use geom::Prim;
+use glam::Vec3;
+use math::{Frame, Rng};
+use rayon::prelude::*;
+use scene::{Material, Scene};
+use std::ops::Range;
+use store::Photon;
+
+/// Mixed into the scene seed for photon streams, so photon `i` and the eye pass's sample `i`
+/// never share random numbers ("emitphot" in ASCII).
+pub const EMIT_STREAM: u64 = 0x656d_6974_7068_6f74;
+
+/// Set in [`Photon::surface`] for a sphere id; clear for a triangle id.
+pub const SPHERE_BIT: u32 = 0x8000_0000;
+
+/// The surface id a photon records for a primitive.
+pub fn surface_id(prim: Prim) -> u32 {
+    prim_id(prim)
+}
+
+/// Photons of a range of paths, in path order (and hit order within a path).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Traced {
+    /// Paths emitted: the range's length, whatever was stored. Estimators divide by the total.
+    pub emitted: u64,
+    pub global: Vec<Photon>,
+    pub caustic: Vec<Photon>,
+}
+
+impl Traced {
+    /// Append the photons of the *next* range: concatenation in index order is the whole run.
+    pub fn append(&mut self, mut next: Traced) {
+        self.emitted += next.emitted;
+        self.global.append(&mut next.global);
+        self.caustic.append(&mut next.caustic);
+    }
+}
+
+/// `0..total` cut into consecutive ranges of `chunk` paths (the last may be shorter): units of
+/// work whose [`trace_range`] results concatenate to the whole run.
+pub fn chunks(total: u64, chunk: u64) -> impl Iterator<Item = Range<u64>> {
+    assert!(chunk > 0, "chunk size must be positive");
+    (0..total.div_ceil(chunk)).map(move |k| k * chunk..((k + 1) * chunk).min(total))
+}
+
+/// Trace photon paths `range` (indices into `0..params.photons`) in increasing order. Path `i`
+/// draws its numbers from `Rng::for_index(scene.seed() ^ EMIT_STREAM, i)` only, so the result
+/// for a range is the concatenation of the results for any split of it.
+///
+/// Rules at a hit (material → BSDF in the shading frame of `hit.ns`; sides are decided with
+/// the geometric normal, and a sample the two normals disagree about ends the path, so no
+/// photon leaks through a surface):
+/// - diffuse: store in the global set if `hit > 1 || store_direct`, in the caustic set if the
+///   path so far is L S+ (at least one specular bounce, no diffuse one); then Russian roulette
+///   (below) and a cosine-weighted direction;
+/// - specular: `Φ *= f |cos θi| / pdf` of a [`TransportMode::Importance`] sample;
+/// - black Lambertian: absorbed.
+///
+/// No adjoint shading-normal correction is applied (Veach 1997 §5.3): like pbrt-v4's SPPM
+/// photon pass (§16.2), the throughput uses the shading-frame cosine only. It matters only
+/// for interpolated normals (the tessellated spheres, which are specular: there
+/// `f |cos| / pdf` is the reflectance or 1 either way).
+///
+/// Russian roulette survival is `P = max_c(ρ_c Φ_c) / max_c(Φ_c)` (Jensen 2001 ch. 5; the
+/// albedo's largest component for a white photon), survivors carry `Φ ρ / P`, whose largest
+/// component equals the incoming one: photon power never grows, so a few bright photons cannot
+/// dominate an estimate. The mean albedo would let `Φ ρ / P` exceed `Φ` (a red wall scales a
+/// photon's red by 2.7) and the channel-blind `max ρ` would keep tracing a red photon on a
+/// green wall with zero power.
+///
+/// A path also ends when nothing it can still do reaches a planned set: a diffuse bounce when
+/// only the caustic set is planned, everything when neither is.
+pub fn trace_range(scene: &Scene, params: &EmitParams, plan: &Plan, range: Range<u64>) -> Traced {
+    let mut out = Traced {
+        emitted: range.end.saturating_sub(range.start),
+        ..Traced::default()
+    };
+    if plan.is_empty() || params.max_depth == 0 {
+        return out;
+    }
+    let Some(lights) = LightSampler::new(scene) else {
+        return out;
+    };
+    let bsdfs: Vec<Option<Bsdf>> = scene.materials.iter().map(bsdf_of).collect();
+    let tracer = Tracer {
+        scene,
+        params,
+        plan,
+        lights: &lights,
+        bsdfs: &bsdfs,
+    };
+    for i in range {
+        tracer.trace_path(i, &mut out);
+    }
+    out
+}
+
+/// [`trace_range`] over `0..params.photons` on rayon's current thread pool, `chunk` paths per
+/// task, concatenated in index order: the same photons as one call to [`trace_range`].
+pub fn trace_parallel(scene: &Scene, params: &EmitParams, plan: &Plan, chunk: u64) -> Traced {
+    let parts: Vec<Traced> = chunks(params.photons, chunk)
+        .collect::<Vec<_>>()
+        .into_par_iter()
+        .map(|r| trace_range(scene, params, plan, r))
+        .collect();
+    let mut out = Traced::default();
+    for p in parts {
+        out.append(p);
+    }
+    out
+}
+
+/// The BSDF photons see at a material; `None` for black (absorbing) surfaces.
+fn bsdf_of(m: &Material) -> Option<Bsdf> {
+    match *m {
+        Material::Lambertian { albedo } => {
+            is_diffuse(m).then_some(Bsdf::Lambertian(Lambertian { albedo }))
+        }
+        Material::Mirror { reflectance } => Some(Bsdf::Mirror(Mirror { reflectance })),
+        Material::Metal { reflectance } => Some(Bsdf::Metal(Metal { reflectance })),
+        Material::Dielectric { ior } => Some(Bsdf::Dielectric(Dielectric { eta: ior })),
+    }
+}
+
+struct Tracer<'a> {
+    scene: &'a Scene,
+    params: &'a EmitParams,
+    plan: &'a Plan,
+    lights: &'a LightSampler,
+    bsdfs: &'a [Option<Bsdf>],
+}
+
+impl Tracer<'_> {
+    fn trace_path(&self, index: u64, out: &mut Traced) {
+        let mut rng = Rng::for_index(self.scene.seed() ^ EMIT_STREAM, index);
+        // Fixed layout: 5 numbers to emit, then 3 per hit, used or not.
+        let (u_light, u_pos, u_dir) = (rng.uniform(), rng.uniform2(), rng.uniform2());
+        let e = self
+            .lights
+            .sample(u_light, u_pos, u_dir, self.params.photons);
+        let mut flux = e.flux.as_vec3();
+        let mut ray = e.ray;
+        let mut specular_bounces = 0u32;
+        let mut diffuse_bounces = 0u32;
+        for hit_index in 0..self.params.max_depth {
+            // Black photons (a channel-less mirror, say) carry nothing; NaN fails this too.
+            if !flux.cmpgt(Vec3::ZERO).any() {
+                return;
+            }
+            let Some(hit) = self.scene.geometry.intersect(&ray) else {
+                return;
+            };
+            let (uc, u) = (rng.uniform(), rng.uniform2());
+            let Some(bsdf) = self.bsdfs[hit.material as usize] else {
+                return;
+            };
+            let d = ray.d.normalize();
+            if let Bsdf::Lambertian(Lambertian { albedo }) = bsdf {
+                let photon = || Photon::new(hit.point.p, flux, d, prim_id(hit.prim));
+                if self.plan.global && (hit_index > 0 || self.params.store_direct) {
+                    out.global.push(photon());
+                }
+                if self.plan.caustic && specular_bounces > 0 && diffuse_bounces == 0 {
+                    out.caustic.push(photon());
+                }
+                // Past a diffuse bounce only the global set can gain photons; past the last
+                // hit, nothing.
+                if !self.plan.global || hit_index + 1 == self.params.max_depth {
+                    return;
+                }
+                let survive = (albedo * flux).max_element() / flux.max_element();
+                if uc >= survive {
+                    return;
+                }
+                flux = flux * albedo / survive;
+                diffuse_bounces += 1;
+            }
+            // Shading frame from the shading normal; sides from the geometric one.
+            let ng = hit.point.n;
+            let wo = -d;
+            let cos_o = wo.dot(ng);
+            let frame = Frame::from_z(hit.ns);
+            let wo_local = frame.to_local(wo);
+            if wo_local.z * cos_o <= 0.0 {
+                return;
+            }
+            let Some(s) = bsdf.sample(wo_local, uc, u, TransportMode::Importance) else {
+                return;
+            };
+            let wi = frame.to_world(s.wi).normalize();
+            let cos_i = wi.dot(ng);
+            let consistent = if s.is_transmission() {
+                cos_i * cos_o < 0.0
+            } else {
+                cos_i * cos_o > 0.0
+            };
+            if !consistent {
+                return;
+            }
+            if s.is_specular() {
+                flux *= s.weight();
+                specular_bounces += 1;
+            }
+            ray = hit.point.spawn_ray(wi);
+        }
+    }
+}
