@@ -11,6 +11,9 @@ cargo xtask <command>
                       render with a progress bar; writes image.exr, image.png, layers/, image.json
   compare A.exr B.exr [--mask x0,y0,x1,y1]
                       RMSE, relative MSE and mean absolute error of A against reference B
+  trace SCENE [--photons N] [--cache DIR] [--threads N] [--force]
+                      trace the photon sets the scene's effects plan asks for into the cache,
+                      or reuse them when the scene and parameters are unchanged
   info SCENE          load a scene and print what it holds
   gen-scenes          rewrite the generated OBJ/MTL files under scenes/
 ";
@@ -31,7 +34,7 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
     match a.as_slice() {
         [] | ["help" | "-h" | "--help", ..] => Ok(Cmd::Help),
         ["gen-scenes"] => Ok(Cmd::GenScenes),
-        [cmd @ ("info" | "render" | "compare"), rest @ ..] => Ok(Cmd::Photonflow(
+        [cmd @ ("info" | "render" | "compare" | "trace"), rest @ ..] => Ok(Cmd::Photonflow(
             std::iter::once(*cmd)
                 .chain(rest.iter().copied())
                 .map(String::from)

@@ -3,8 +3,10 @@
 //! nothing here panics on bad input.
 
 mod bench;
+mod pipeline;
 mod progress;
 mod render;
+mod trace;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -54,6 +56,21 @@ enum Cmd {
         /// Exposure of the PNG in stops.
         #[arg(long, default_value_t = 0.0)]
         exposure: f32,
+    },
+    /// Trace the photon sets a scene needs into the cache (or reuse them).
+    Trace {
+        scene: PathBuf,
+        /// Photon paths to emit (default: the scene's [photons] table).
+        #[arg(long)]
+        photons: Option<u64>,
+        /// Cache directory of photon files.
+        #[arg(long, default_value = "out/cache")]
+        cache: PathBuf,
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Trace even if the cache holds the sets.
+        #[arg(long)]
+        force: bool,
     },
     /// Error metrics of image A against reference B (linear EXR files).
     Compare {
@@ -120,6 +137,25 @@ fn run(cmd: Cmd) -> Result<(), String> {
             other => Err(format!("unknown --method `{other}` (known: path)")),
         },
         Cmd::Compare { a, b, mask } => render::compare(&a, &b, mask),
+        Cmd::Trace {
+            scene,
+            photons,
+            cache,
+            threads,
+            force,
+        } => {
+            let s = scene::Scene::load(&scene).map_err(|e| e.to_string())?;
+            trace::trace(
+                &s,
+                &trace::TraceArgs {
+                    photons,
+                    cache,
+                    threads,
+                    force,
+                },
+            )
+            .map(|_| ())
+        }
     }
 }
 

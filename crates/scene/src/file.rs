@@ -45,6 +45,13 @@ pub struct SceneFile {
     /// Materials by name. They override MTL materials of the same name.
     #[serde(default, rename = "material")]
     pub materials: BTreeMap<String, MaterialDesc>,
+    /// Photon-tracing parameters (`[photons]`). Opaque here: the emit stage reads them
+    /// (`emit::EmitParams`, with its own unknown-key check), so this crate stays below it.
+    #[serde(default)]
+    pub photons: toml::Table,
+    /// Density-estimation parameters (`[estimate]`), read by the density stage.
+    #[serde(default)]
+    pub estimate: toml::Table,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
