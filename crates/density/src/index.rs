@@ -43,24 +43,28 @@ fn radius2(r_max: f32) -> f32 {
     if r_max >= 0.0 { r_max * r_max } else { 0.0 }
 }
 
-/// A bounded max-heap on `(d2, index)` kept in the caller's `Vec` (no allocation per
-/// query once the scratch vector has grown). `bound` is the squared distance a point must not
-/// exceed to be offered: `r_max^2` while filling, then the current k-th distance, so the
-/// search radius shrinks as better points arrive.
-struct Heap<'a> {
+/// The k smallest `(d2, index)` so far, kept in the caller's `Vec` (no allocation per
+/// query once the scratch vector has grown). Not a heap: candidates are appended to a buffer
+/// of up to 2k and, when it fills, `select_nth_unstable` keeps the k smallest (amortised
+/// O(1) per candidate against a heap's O(log k); the "buffered k-selection" used by GPU
+/// k-NN, e.g. Johnson, Douze, Jégou 2019, "Billion-scale similarity search with GPUs").
+/// `bound` is the squared distance a point must not exceed to be offered: `r_max^2` until
+/// k points are seen, then the k-th smallest distance, so the search radius shrinks.
+struct Best<'a> {
     out: &'a mut Vec<Neighbor>,
     k: usize,
-    r2: f32,
+    cap: usize,
     bound: f32,
 }
 
-impl<'a> Heap<'a> {
-    fn new(out: &'a mut Vec<Neighbor>, k: usize, r2: f32) -> Heap<'a> {
+impl<'a> Best<'a> {
+    fn new(out: &'a mut Vec<Neighbor>, k: usize, r2: f32) -> Best<'a> {
         out.clear();
-        Heap {
+        Best {
             out,
             k,
-            r2,
+            // First compaction as soon as k points are in, to start shrinking the radius.
+            cap: k,
             bound: r2,
         }
     }
@@ -68,47 +72,28 @@ impl<'a> Heap<'a> {
     /// Offer a point whose `d2 <= self.bound` (checked by the caller, on the hot path).
     #[inline]
     fn offer(&mut self, n: Neighbor) {
-        let out = &mut *self.out;
-        if out.len() < self.k {
-            out.push(n);
-            // Sift up.
-            let mut i = out.len() - 1;
-            while i > 0 {
-                let parent = (i - 1) / 2;
-                if out[parent].key() >= out[i].key() {
-                    break;
-                }
-                out.swap(parent, i);
-                i = parent;
-            }
-            if out.len() == self.k {
-                self.bound = out[0].d2;
-            }
-        } else if n.key() < out[0].key() {
-            out[0] = n;
-            // Sift down.
-            let len = out.len();
-            let mut i = 0;
-            loop {
-                let (l, r) = (2 * i + 1, 2 * i + 2);
-                let mut largest = i;
-                if l < len && out[l].key() > out[largest].key() {
-                    largest = l;
-                }
-                if r < len && out[r].key() > out[largest].key() {
-                    largest = r;
-                }
-                if largest == i {
-                    break;
-                }
-                out.swap(i, largest);
-                i = largest;
-            }
-            self.bound = out[0].d2.min(self.r2);
+        self.out.push(n);
+        if self.out.len() >= self.cap {
+            self.compact();
         }
     }
 
+    /// Keep the k smallest keys; the k-th becomes the bound (points tied with it in d2 may
+    /// still win on index, so the caller keeps `d2 <= bound`).
+    #[cold]
+    fn compact(&mut self) {
+        let k = self.k;
+        self.out.select_nth_unstable_by_key(k - 1, |n| n.key());
+        self.out.truncate(k);
+        self.bound = self.out[k - 1].d2;
+        self.cap = k.saturating_mul(2).max(k + 16);
+    }
+
     fn finish(self) {
+        if self.out.len() > self.k {
+            self.out.select_nth_unstable_by_key(self.k - 1, |n| n.key());
+            self.out.truncate(self.k);
+        }
         self.out.sort_unstable_by_key(|n| n.key());
     }
 }
@@ -121,7 +106,7 @@ impl<'a> Heap<'a> {
 /// index range, and its split axis is one byte stored at `axis[mid]`.
 ///
 /// Hot/cold split (anchor A4.1): the query reads `pos` (and `axis`) only; `ids` (the
-/// original index of each slot) is read when a point enters the result heap.
+/// original index of each slot) is read when a point enters the result buffer.
 #[derive(Clone, Debug)]
 pub struct KdTree {
     pos: Vec<[f32; 3]>,
@@ -129,9 +114,9 @@ pub struct KdTree {
     axis: Vec<u8>,
 }
 
-/// Ranges of at most this many points are scanned linearly. 8 was fastest of {4, 8, 16, 32}
-/// at 1M photons for k = 50..1000 (measured with `bench::bench_knn`).
-const LEAF: usize = 8;
+/// Ranges of at most this many points are scanned linearly. 16 beat 8 and 32 at 1M
+/// photons for k = 50..1000 (`bench::bench_knn`, release, one thread).
+const LEAF: usize = 16;
 
 impl KdTree {
     /// Build over `points`; results index into `points`. O(n log n): one bounding box and
@@ -200,29 +185,30 @@ impl KdTree {
 
     /// The `k` nearest points with `d2 <= r_max^2`, sorted by `(d2, index)`, into `out`.
     pub fn knn(&self, q: Vec3, k: usize, r_max: f32, out: &mut Vec<Neighbor>) {
-        let mut heap = Heap::new(out, k, radius2(r_max));
+        let mut best = Best::new(out, k, radius2(r_max));
         if k == 0 || self.pos.is_empty() {
             return;
         }
         let q = q.to_array();
-        // (lo, hi, lower bound on d2 for the range). Depth <= 32, two entries per level.
-        let mut stack = [(0u32, 0u32, 0f32); 72];
-        stack[0] = (0, self.pos.len() as u32, 0.0);
+        // (lo, hi, per-axis distance from q to the range's cell, lower bound on d2).
+        // Depth <= 32, at most two entries per level.
+        let mut stack = [(0u32, 0u32, [0f32; 3], 0f32); 72];
+        stack[0] = (0, self.pos.len() as u32, [0.0; 3], 0.0);
         let mut sp = 1;
         while sp > 0 {
             sp -= 1;
-            let (lo, hi, dmin) = stack[sp];
+            let (lo, hi, off, dmin) = stack[sp];
             // Strictly greater: a point at exactly the k-th distance with a smaller index
             // still wins its tie.
-            if dmin > heap.bound {
+            if dmin > best.bound {
                 continue;
             }
             let (lo, hi) = (lo as usize, hi as usize);
             if hi - lo <= LEAF {
                 for i in lo..hi {
                     let d2 = dist2(self.pos[i], q);
-                    if d2 <= heap.bound {
-                        heap.offer(Neighbor {
+                    if d2 <= best.bound {
+                        best.offer(Neighbor {
                             index: self.ids[i],
                             d2,
                         });
@@ -233,27 +219,32 @@ impl KdTree {
             let mid = lo + (hi - lo) / 2;
             let split = self.pos[mid];
             let d2 = dist2(split, q);
-            if d2 <= heap.bound {
-                heap.offer(Neighbor {
+            if d2 <= best.bound {
+                best.offer(Neighbor {
                     index: self.ids[mid],
                     d2,
                 });
             }
             let a = self.axis[mid] as usize;
             let diff = q[a] - split[a];
-            // The far side lies beyond the split plane: its points are at least diff^2
-            // away (f32 rounding is monotone, so this bound never prunes a true neighbour).
-            let dfar = (diff * diff).max(dmin);
+            // The far cell's distance from q (Arya & Mount 1993, "Algorithms for fast
+            // vector quantization": incremental distance to the cell, tighter than the
+            // plane alone). Summed like `dist2` from per-axis offsets that never exceed
+            // |q - p| for a point p in the cell, and f32 rounding is monotone, so the
+            // bound never prunes a true neighbour.
+            let mut far_off = off;
+            far_off[a] = diff.abs().max(off[a]);
+            let dfar = dist2(far_off, [0.0; 3]);
             let (near, far) = if diff < 0.0 {
                 ((lo, mid), (mid + 1, hi))
             } else {
                 ((mid + 1, hi), (lo, mid))
             };
-            stack[sp] = (far.0 as u32, far.1 as u32, dfar);
-            stack[sp + 1] = (near.0 as u32, near.1 as u32, dmin);
+            stack[sp] = (far.0 as u32, far.1 as u32, far_off, dfar);
+            stack[sp + 1] = (near.0 as u32, near.1 as u32, off, dmin);
             sp += 2;
         }
-        heap.finish();
+        best.finish();
     }
 }
 
@@ -273,21 +264,21 @@ impl Brute {
     }
 
     pub fn knn(&self, q: Vec3, k: usize, r_max: f32, out: &mut Vec<Neighbor>) {
-        let mut heap = Heap::new(out, k, radius2(r_max));
+        let mut best = Best::new(out, k, radius2(r_max));
         if k == 0 {
             return;
         }
         let q = q.to_array();
         for (i, &p) in self.pos.iter().enumerate() {
             let d2 = dist2(p, q);
-            if d2 <= heap.bound {
-                heap.offer(Neighbor {
+            if d2 <= best.bound {
+                best.offer(Neighbor {
                     index: i as u32,
                     d2,
                 });
             }
         }
-        heap.finish();
+        best.finish();
     }
 }
 
