@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use std::num::NonZero;
 
 /// One search result: a point's index (into the slice the index was built from) and its
-/// squared distance to the query, in f32 exactly as [`dist2`] computes it.
+/// squared distance to the query, in f32, summed x + y + z by every back-end.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Neighbor {
     pub index: u32,

@@ -276,6 +276,8 @@ each_index!(degenerate_inputs_give_zero_not_nan, |kind: IndexKind| {
     // Photons arrive from above: seen from below (or with no normal) nothing passes.
     assert_eq!(map.irradiance(x, -Vec3::Y, &p, &mut s), Vec3::ZERO);
     assert_eq!(map.irradiance(x, Vec3::ZERO, &p, &mut s), Vec3::ZERO);
+    // A NaN query point finds nothing.
+    assert_eq!(map.irradiance(Vec3::NAN, Vec3::Y, &p, &mut s), Vec3::ZERO);
     assert!(map.irradiance(x, Vec3::Y, &p, &mut s).x > 0.0);
 });
 
