@@ -1,0 +1,185 @@
+//! The irradiance estimate (algorithms.md §2.1): E(x) = (1/r²) Σ_p Φ_p K(|x − x_p| / r),
+//! r the distance to the k-th nearest photon (a balloon estimator, Jensen 2001 §7.1).
+
+use crate::index::{Index, IndexKind, Neighbor};
+use crate::kernel::Kernel;
+use glam::{DVec3, Vec3};
+use serde::{Deserialize, Serialize};
+use store::Photon;
+
+/// How to estimate. Round-trips through serde (parameter files; `r_max` infinite is spelled
+/// `inf` in TOML). JSON cannot hold an infinite `r_max`: use a large finite one there.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct EstimateParams {
+    /// Photons per estimate (k of k-NN). 0 gives zero.
+    pub k: usize,
+    /// Search radius limit; infinity = pure k-NN (the framework uses 1000 scene units).
+    pub r_max: f32,
+    pub kernel: Kernel,
+    /// Keep only photons arriving from the normal's side: travel direction · n < 0.
+    pub same_side: bool,
+    /// Topological test (worksheet 7, algorithms.md §2.4): keep photon p only if
+    /// |n · (x_p − x)| < eps |x_p − x|, i.e. within asin(eps) of the tangent plane. `None`
+    /// disables it. Rejected photons still count towards k and r (their area is elsewhere).
+    pub topo: Option<f32>,
+    /// Garcia et al. 2012 ("Description and solution of an unreported intrinsic bias in
+    /// photon mapping density estimation with constant kernel", CGF 31(1)): when r is the
+    /// distance to the k-th photon, sum only the k − 1 nearer ones.
+    pub drop_kth: bool,
+}
+
+impl Default for EstimateParams {
+    /// The framework's `irradiance_estimate`: k = 50, uniform kernel, same-side test.
+    fn default() -> EstimateParams {
+        EstimateParams {
+            k: 50,
+            r_max: f32::INFINITY,
+            kernel: Kernel::Uniform,
+            same_side: true,
+            topo: None,
+            drop_kth: false,
+        }
+    }
+}
+
+/// Photons plus a spatial index over their positions.
+pub struct PhotonMap {
+    photons: Vec<Photon>,
+    index: Index,
+    emitted: u64,
+}
+
+impl PhotonMap {
+    /// `emitted`: the number of light paths traced to make these photons (not the number
+    /// stored; anchor A3.3). Estimates divide the stored `power` by it, so photons carry the
+    /// flux of their path as traced. Pass 1 if the powers are already per-emitted-path; 0 is
+    /// treated as 1. With the kd-tree the photons are reordered to tree order (neighbours
+    /// then sit together in memory), so `photons()[i]` is no longer the i-th given.
+    pub fn build(photons: Vec<Photon>, emitted: u64, kind: IndexKind) -> PhotonMap {
+        let pos: Vec<[f32; 3]> = photons.iter().map(|p| p.pos).collect();
+        let (photons, index) = match Index::build(kind, &pos) {
+            Index::KdTree(mut tree) => {
+                let reordered = tree.order().iter().map(|&i| photons[i as usize]).collect();
+                tree.relabel_by_slot();
+                (reordered, Index::KdTree(tree))
+            }
+            index => (photons, index),
+        };
+        PhotonMap {
+            photons,
+            index,
+            emitted,
+        }
+    }
+
+    pub fn photons(&self) -> &[Photon] {
+        &self.photons
+    }
+
+    pub fn len(&self) -> usize {
+        self.photons.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.photons.is_empty()
+    }
+
+    pub fn emitted(&self) -> u64 {
+        self.emitted
+    }
+
+    pub fn index(&self) -> &Index {
+        &self.index
+    }
+
+    /// k nearest photons within `r_max`, indices into [`PhotonMap::photons`].
+    pub fn knn(&self, x: Vec3, k: usize, r_max: f32, out: &mut Vec<Neighbor>) {
+        self.index.knn(x, k, r_max, out);
+    }
+
+    /// Irradiance E (flux per area) at `x` on a surface with unit normal `n`; f64 sums.
+    ///
+    /// r is the distance to the k-th nearest photon within `r_max`. With fewer than k found,
+    /// r = `r_max` if finite, else the distance to the farthest found. No photon found, or
+    /// r = 0 (every photon found sits exactly at `x`: the density is undefined), gives zero.
+    /// The result is clamped to [0, f32::MAX] (a NaN sum becomes 0). `n` must be unit
+    /// length. `scratch` holds the neighbours after the call.
+    pub fn irradiance(
+        &self,
+        x: Vec3,
+        n: Vec3,
+        p: &EstimateParams,
+        scratch: &mut Vec<Neighbor>,
+    ) -> Vec3 {
+        self.index.knn(x, p.k, p.r_max, scratch);
+        self.irradiance_from_neighbors(x, n, p, scratch)
+    }
+
+    /// [`PhotonMap::irradiance`] from neighbours already found with `p.k` and `p.r_max`
+    /// (e.g. to compare kernels on one search).
+    pub fn irradiance_from_neighbors(
+        &self,
+        x: Vec3,
+        n: Vec3,
+        p: &EstimateParams,
+        neighbors: &[Neighbor],
+    ) -> Vec3 {
+        let found = neighbors.len();
+        if found == 0 {
+            return Vec3::ZERO;
+        }
+        let r_max_finite = p.r_max.is_finite();
+        // Is the radius set by a photon (which then lies on the kernel's boundary)?
+        let (r2, on_boundary) = if found == p.k || !r_max_finite {
+            (neighbors[found - 1].d2 as f64, true)
+        } else {
+            ((p.r_max as f64).powi(2), false)
+        };
+        if !(r2 > 0.0 && r2.is_finite()) {
+            return Vec3::ZERO;
+        }
+        let used = if p.drop_kth && on_boundary {
+            found - 1
+        } else {
+            found
+        };
+        let inv_r2 = 1.0 / r2;
+        let mut sum = DVec3::ZERO;
+        for nb in &neighbors[..used] {
+            let ph = &self.photons[nb.index as usize];
+            if p.same_side && ph.direction().dot(n) >= 0.0 {
+                continue;
+            }
+            if let Some(eps) = p.topo {
+                let v = ph.position() - x;
+                let len = v.length();
+                // A photon at x itself lies in every tangent plane.
+                if len > 0.0 && n.dot(v).abs() >= eps * len {
+                    continue;
+                }
+            }
+            let t = (nb.d2 as f64 * inv_r2).sqrt();
+            sum += ph.power().as_dvec3() * p.kernel.shape(t);
+        }
+        let e = sum * (p.kernel.norm() * inv_r2 / self.emitted.max(1) as f64);
+        e.as_vec3().clamp(Vec3::ZERO, Vec3::splat(f32::MAX))
+    }
+
+    /// Radiance leaving a Lambertian surface of albedo `rho` at `x`: ρ/π · E.
+    pub fn radiance_lambertian(
+        &self,
+        x: Vec3,
+        n: Vec3,
+        rho: Vec3,
+        p: &EstimateParams,
+        scratch: &mut Vec<Neighbor>,
+    ) -> Vec3 {
+        radiance_lambertian(self.irradiance(x, n, p, scratch), rho)
+    }
+}
+
+/// L = ρ/π · E for a Lambertian surface of albedo ρ.
+pub fn radiance_lambertian(e: Vec3, rho: Vec3) -> Vec3 {
+    rho * std::f32::consts::FRAC_1_PI * e
+}

@@ -1,0 +1,390 @@
+//! k-nearest search under a maximum radius, three interchangeable back-ends (a closed enum,
+//! style anchor A1.1): our own kd-tree, kiddo's immutable tree, and brute force (the reference).
+//!
+//! Every back-end returns the same answer: the `k` points with the smallest key
+//! `(d2, index)` among those with `d2 <= r_max^2`, sorted by that key. Ties at the k-th
+//! distance are therefore broken by the smaller index, identically everywhere, so the tests
+//! can demand exact equality with brute force.
+
+use glam::Vec3;
+use kiddo::SquaredEuclidean;
+use kiddo::immutable::float::kdtree::ImmutableKdTree;
+use serde::{Deserialize, Serialize};
+use std::num::NonZero;
+
+/// One search result: a point's index (into the slice the index was built from) and its
+/// squared distance to the query, in f32, summed x + y + z by every back-end.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Neighbor {
+    pub index: u32,
+    pub d2: f32,
+}
+
+impl Neighbor {
+    /// `(d2, index)` as one integer: for non-negative floats the IEEE bit pattern is ordered
+    /// like the value, so one u64 comparison orders by distance, then by index.
+    #[inline]
+    fn key(self) -> u64 {
+        ((self.d2.to_bits() as u64) << 32) | self.index as u64
+    }
+}
+
+/// Squared distance in f32, summed in a fixed order (x, y, z) by every back-end, so that
+/// results compare bit for bit.
+#[inline]
+pub(crate) fn dist2(a: [f32; 3], b: [f32; 3]) -> f32 {
+    let (dx, dy, dz) = (a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+    dx * dx + dy * dy + dz * dz
+}
+
+/// `r_max^2`; infinity means "no maximum". NaN or negative radii find nothing.
+#[inline]
+fn radius2(r_max: f32) -> f32 {
+    if r_max >= 0.0 { r_max * r_max } else { 0.0 }
+}
+
+/// The k smallest `(d2, index)` so far, kept in the caller's `Vec` (no allocation per
+/// query once the scratch vector has grown). Not a heap: candidates are appended to a buffer
+/// of up to 2k and, when it fills, `select_nth_unstable` keeps the k smallest (amortised
+/// O(1) per candidate against a heap's O(log k); the "buffered k-selection" used by GPU
+/// k-NN, e.g. Johnson, Douze, Jégou 2019, "Billion-scale similarity search with GPUs").
+/// `bound` is the squared distance a point must not exceed to be offered: `r_max^2` until
+/// k points are seen, then the k-th smallest distance, so the search radius shrinks.
+struct Best<'a> {
+    out: &'a mut Vec<Neighbor>,
+    k: usize,
+    cap: usize,
+    bound: f32,
+}
+
+impl<'a> Best<'a> {
+    fn new(out: &'a mut Vec<Neighbor>, k: usize, r2: f32) -> Best<'a> {
+        out.clear();
+        Best {
+            out,
+            k,
+            // First compaction as soon as k points are in, to start shrinking the radius.
+            cap: k,
+            bound: r2,
+        }
+    }
+
+    /// Offer a point whose `d2 <= self.bound` (checked by the caller, on the hot path).
+    #[inline]
+    fn offer(&mut self, n: Neighbor) {
+        self.out.push(n);
+        if self.out.len() >= self.cap {
+            self.compact();
+        }
+    }
+
+    /// Keep the k smallest keys; the k-th becomes the bound (points tied with it in d2 may
+    /// still win on index, so the caller keeps `d2 <= bound`).
+    #[cold]
+    fn compact(&mut self) {
+        let k = self.k;
+        self.out.select_nth_unstable_by_key(k - 1, |n| n.key());
+        self.out.truncate(k);
+        self.bound = self.out[k - 1].d2;
+        self.cap = k.saturating_mul(2).max(k + 16);
+    }
+
+    fn finish(self) {
+        if self.out.len() > self.k {
+            self.out.select_nth_unstable_by_key(self.k - 1, |n| n.key());
+            self.out.truncate(self.k);
+        }
+        self.out.sort_unstable_by_key(|n| n.key());
+    }
+}
+
+/// Our kd-tree, built in place (Jensen 2001, §6.3 "balanced kd-tree"; Tungsten's in-place
+/// layout, anchor A3.4): the positions are permuted so that every index range `[lo, hi)`
+/// longer than a leaf is split at its median `mid = (lo + hi) / 2` along the axis of largest
+/// extent; `[lo, mid)` lies at or below `pos[mid][axis]`, `[mid + 1, hi)` at or above, and
+/// `pos[mid]` is the node's own point. No node structs, no child pointers: a node *is* an
+/// index range, and its split axis is one byte stored at `axis[mid]`.
+///
+/// Hot/cold split (anchor A4.1): the query reads `pos` (and `axis`) only; `ids` (the
+/// original index of each slot) is read when a point enters the result buffer.
+#[derive(Clone, Debug)]
+pub struct KdTree {
+    pos: Vec<[f32; 3]>,
+    ids: Vec<u32>,
+    axis: Vec<u8>,
+}
+
+/// Ranges of at most this many points are scanned linearly. 16 beat 8 and 32 at 1M
+/// photons for k = 50..1000 (`bench::bench_knn`, release, one thread).
+const LEAF: usize = 16;
+
+impl KdTree {
+    /// Build over `points`; results index into `points`. O(n log n): one bounding box and
+    /// one `select_nth_unstable` (introselect, O(n)) per level.
+    pub fn build(points: &[[f32; 3]]) -> KdTree {
+        assert!(points.len() <= u32::MAX as usize, "at most 2^32 - 1 points");
+        let mut items: Vec<([f32; 3], u32)> = points
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| (p, i as u32))
+            .collect();
+        let mut axis = vec![0u8; points.len()];
+        let mut stack = vec![(0usize, points.len())];
+        while let Some((lo, hi)) = stack.pop() {
+            if hi - lo <= LEAF {
+                continue;
+            }
+            let (mut min, mut max) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+            for (p, _) in &items[lo..hi] {
+                for a in 0..3 {
+                    min[a] = min[a].min(p[a]);
+                    max[a] = max[a].max(p[a]);
+                }
+            }
+            let ext = [max[0] - min[0], max[1] - min[1], max[2] - min[2]];
+            let a = if ext[0] >= ext[1] && ext[0] >= ext[2] {
+                0
+            } else if ext[1] >= ext[2] {
+                1
+            } else {
+                2
+            };
+            let mid = lo + (hi - lo) / 2;
+            items[lo..hi].select_nth_unstable_by(mid - lo, |x, y| x.0[a].total_cmp(&y.0[a]));
+            axis[mid] = a as u8;
+            // The median stays put as the node's own point; the children exclude it, so
+            // their partitions never move it and `pos[mid]` keeps the split value.
+            stack.push((lo, mid));
+            stack.push((mid + 1, hi));
+        }
+        let (pos, ids) = items.into_iter().unzip();
+        KdTree { pos, ids, axis }
+    }
+
+    pub fn len(&self) -> usize {
+        self.pos.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.pos.is_empty()
+    }
+
+    /// Original index of each tree slot: `order()[slot]`. A caller that reorders its own
+    /// records by this (for memory locality) then calls [`KdTree::relabel_by_slot`].
+    pub fn order(&self) -> &[u32] {
+        &self.ids
+    }
+
+    /// Make results index tree slots instead of the original points (after the caller has
+    /// permuted its records by [`KdTree::order`]).
+    pub fn relabel_by_slot(&mut self) {
+        for (i, id) in self.ids.iter_mut().enumerate() {
+            *id = i as u32;
+        }
+    }
+
+    /// The `k` nearest points with `d2 <= r_max^2`, sorted by `(d2, index)`, into `out`.
+    pub fn knn(&self, q: Vec3, k: usize, r_max: f32, out: &mut Vec<Neighbor>) {
+        let mut best = Best::new(out, k, radius2(r_max));
+        if k == 0 || self.pos.is_empty() {
+            return;
+        }
+        let q = q.to_array();
+        // (lo, hi, per-axis distance from q to the range's cell, lower bound on d2).
+        // Depth <= 32, at most two entries per level.
+        let mut stack = [(0u32, 0u32, [0f32; 3], 0f32); 72];
+        stack[0] = (0, self.pos.len() as u32, [0.0; 3], 0.0);
+        let mut sp = 1;
+        while sp > 0 {
+            sp -= 1;
+            let (lo, hi, off, dmin) = stack[sp];
+            // Strictly greater: a point at exactly the k-th distance with a smaller index
+            // still wins its tie.
+            if dmin > best.bound {
+                continue;
+            }
+            let (lo, hi) = (lo as usize, hi as usize);
+            if hi - lo <= LEAF {
+                for i in lo..hi {
+                    let d2 = dist2(self.pos[i], q);
+                    if d2 <= best.bound {
+                        best.offer(Neighbor {
+                            index: self.ids[i],
+                            d2,
+                        });
+                    }
+                }
+                continue;
+            }
+            let mid = lo + (hi - lo) / 2;
+            let split = self.pos[mid];
+            let d2 = dist2(split, q);
+            if d2 <= best.bound {
+                best.offer(Neighbor {
+                    index: self.ids[mid],
+                    d2,
+                });
+            }
+            let a = self.axis[mid] as usize;
+            let diff = q[a] - split[a];
+            // The far cell's distance from q (Arya & Mount 1993, "Algorithms for fast
+            // vector quantization": incremental distance to the cell, tighter than the
+            // plane alone). Summed like `dist2` from per-axis offsets that never exceed
+            // |q - p| for a point p in the cell, and f32 rounding is monotone, so the
+            // bound never prunes a true neighbour.
+            let mut far_off = off;
+            far_off[a] = diff.abs().max(off[a]);
+            let dfar = dist2(far_off, [0.0; 3]);
+            let (near, far) = if diff < 0.0 {
+                ((lo, mid), (mid + 1, hi))
+            } else {
+                ((mid + 1, hi), (lo, mid))
+            };
+            stack[sp] = (far.0 as u32, far.1 as u32, far_off, dfar);
+            stack[sp + 1] = (near.0 as u32, near.1 as u32, off, dmin);
+            sp += 2;
+        }
+        best.finish();
+    }
+}
+
+/// Brute force: every point tested. The reference the others are checked against, and the
+/// fastest choice for a few hundred points.
+#[derive(Clone, Debug)]
+pub struct Brute {
+    pos: Vec<[f32; 3]>,
+}
+
+impl Brute {
+    pub fn build(points: &[[f32; 3]]) -> Brute {
+        assert!(points.len() <= u32::MAX as usize, "at most 2^32 - 1 points");
+        Brute {
+            pos: points.to_vec(),
+        }
+    }
+
+    pub fn knn(&self, q: Vec3, k: usize, r_max: f32, out: &mut Vec<Neighbor>) {
+        let mut best = Best::new(out, k, radius2(r_max));
+        if k == 0 {
+            return;
+        }
+        let q = q.to_array();
+        for (i, &p) in self.pos.iter().enumerate() {
+            let d2 = dist2(p, q);
+            if d2 <= best.bound {
+                best.offer(Neighbor {
+                    index: i as u32,
+                    d2,
+                });
+            }
+        }
+        best.finish();
+    }
+}
+
+/// kiddo 5's `ImmutableKdTree` (bucket 32, u32 items). kiddo orders results by distance
+/// only, so ties at the k-th distance come back in arbitrary order. We ask for `k + 1`: if
+/// the (k+1)-th is strictly farther than the k-th, the k nearest are unique; otherwise (a
+/// tie, rare except for duplicate points) a second `within` query collects every point at or
+/// inside the k-th distance and we keep the first `k` by `(d2, index)`.
+pub struct Kiddo {
+    pos: Vec<[f32; 3]>,
+    tree: Option<ImmutableKdTree<f32, u32, 3, 32>>,
+}
+
+impl Kiddo {
+    pub fn build(points: &[[f32; 3]]) -> Kiddo {
+        assert!(points.len() <= u32::MAX as usize, "at most 2^32 - 1 points");
+        let tree = (!points.is_empty()).then(|| ImmutableKdTree::new_from_slice(points));
+        Kiddo {
+            pos: points.to_vec(),
+            tree,
+        }
+    }
+
+    pub fn knn(&self, q: Vec3, k: usize, r_max: f32, out: &mut Vec<Neighbor>) {
+        out.clear();
+        let r2 = radius2(r_max);
+        let (Some(tree), Some(k1)) = (&self.tree, NonZero::new(k)) else {
+            return;
+        };
+        let q = q.to_array();
+        let k1 = k1.saturating_add(1);
+        // Our own d2 (same summation order as kiddo's, but do not depend on it).
+        let push = |out: &mut Vec<Neighbor>, item: u32| {
+            let d2 = dist2(self.pos[item as usize], q);
+            if d2 <= r2 {
+                out.push(Neighbor { index: item, d2 });
+            }
+        };
+        for n in tree.nearest_n_within::<SquaredEuclidean>(&q, r2, k1, true) {
+            push(out, n.item);
+        }
+        out.sort_unstable_by_key(|n| n.key());
+        if out.len() > k && out[k].d2 == out[k - 1].d2 {
+            let dk = out[k - 1].d2;
+            out.clear();
+            for n in tree.within_unsorted::<SquaredEuclidean>(&q, dk) {
+                push(out, n.item);
+            }
+            out.sort_unstable_by_key(|n| n.key());
+        }
+        out.truncate(k);
+    }
+}
+
+/// Which back-end a [`crate::PhotonMap`] uses (parameter files name it in snake_case).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IndexKind {
+    KdTree,
+    Kiddo,
+    Brute,
+}
+
+impl IndexKind {
+    pub const ALL: [IndexKind; 3] = [IndexKind::KdTree, IndexKind::Kiddo, IndexKind::Brute];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            IndexKind::KdTree => "kd_tree",
+            IndexKind::Kiddo => "kiddo",
+            IndexKind::Brute => "brute",
+        }
+    }
+}
+
+/// A built index: a closed set of back-ends, dispatched by `match` (anchor A1.1).
+pub enum Index {
+    KdTree(KdTree),
+    Kiddo(Kiddo),
+    Brute(Brute),
+}
+
+impl Index {
+    pub fn build(kind: IndexKind, points: &[[f32; 3]]) -> Index {
+        match kind {
+            IndexKind::KdTree => Index::KdTree(KdTree::build(points)),
+            IndexKind::Kiddo => Index::Kiddo(Kiddo::build(points)),
+            IndexKind::Brute => Index::Brute(Brute::build(points)),
+        }
+    }
+
+    pub fn kind(&self) -> IndexKind {
+        match self {
+            Index::KdTree(_) => IndexKind::KdTree,
+            Index::Kiddo(_) => IndexKind::Kiddo,
+            Index::Brute(_) => IndexKind::Brute,
+        }
+    }
+
+    /// The `k` nearest points with `d2 <= r_max^2` (`r_max` infinite: no limit), sorted by
+    /// `(d2, index)`, written to `out` (cleared first). Same answer from every back-end.
+    pub fn knn(&self, q: Vec3, k: usize, r_max: f32, out: &mut Vec<Neighbor>) {
+        match self {
+            Index::KdTree(t) => t.knn(q, k, r_max, out),
+            Index::Kiddo(t) => t.knn(q, k, r_max, out),
+            Index::Brute(t) => t.knn(q, k, r_max, out),
+        }
+    }
+}

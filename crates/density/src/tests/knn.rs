@@ -1,0 +1,152 @@
+use super::*;
+use crate::index::dist2;
+use crate::{Index, Neighbor, PhotonMap};
+use glam::Vec3;
+use math::Rng;
+use store::Photon;
+
+/// The oracle: sort everything within `r_max` by (d2, index), keep `k`.
+fn reference(points: &[[f32; 3]], q: Vec3, k: usize, r_max: f32) -> Vec<Neighbor> {
+    let r2 = if r_max >= 0.0 { r_max * r_max } else { 0.0 };
+    let mut v: Vec<Neighbor> = points
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| Neighbor {
+            index: i as u32,
+            d2: dist2(p, q.to_array()),
+        })
+        .filter(|n| n.d2 <= r2)
+        .collect();
+    v.sort_by(|a, b| a.d2.total_cmp(&b.d2).then(a.index.cmp(&b.index)));
+    v.truncate(k);
+    v
+}
+
+fn check(
+    index: &Index,
+    points: &[[f32; 3]],
+    q: Vec3,
+    k: usize,
+    r_max: f32,
+    out: &mut Vec<Neighbor>,
+) {
+    index.knn(q, k, r_max, out);
+    let want = reference(points, q, k, r_max);
+    assert_eq!(
+        *out,
+        want,
+        "{} n={} q={q} k={k} r_max={r_max}",
+        index.kind().name(),
+        points.len()
+    );
+}
+
+/// Points on the integer grid {0..3}^3: many exact ties and duplicates.
+fn grid_points(n: usize, rng: &mut Rng) -> Vec<[f32; 3]> {
+    (0..n)
+        .map(|_| [0, 0, 0].map(|_: i32| rng.below(4) as f32))
+        .collect()
+}
+
+fn random_points(n: usize, rng: &mut Rng) -> Vec<[f32; 3]> {
+    (0..n)
+        .map(|_| [rng.uniform(), rng.uniform(), rng.uniform()])
+        .collect()
+}
+
+each_index!(
+    equals_brute_force_for_every_n_up_to_64,
+    |kind: IndexKind| {
+        let mut out = Vec::new();
+        for n in 0..=64usize {
+            let mut rng = Rng::for_index(7, n as u64);
+            for (points, lo, step, radius) in [
+                (grid_points(n, &mut rng), -0.5f32, 1.3f32, 1.5f32),
+                (random_points(n, &mut rng), -0.25, 0.5, 0.4),
+            ] {
+                let index = Index::build(kind, &points);
+                for i in 0..64 {
+                    let q = Vec3::new(
+                        lo + step * (i % 4) as f32,
+                        lo + step * (i / 4 % 4) as f32,
+                        lo + step * (i / 16) as f32,
+                    );
+                    for k in [0, 1, 2, 5, n, n + 3] {
+                        for r_max in [f32::INFINITY, radius, 0.0] {
+                            check(&index, &points, q, k, r_max, &mut out);
+                        }
+                    }
+                }
+            }
+        }
+    }
+);
+
+each_index!(equals_brute_force_on_10k_photons, |kind: IndexKind| {
+    let mut rng = Rng::new(11);
+    let mut points: Vec<[f32; 3]> = (0..10_000)
+        .map(|_| crate::bench::point_on_unit_cube(&mut rng))
+        .collect();
+    // A few exact duplicates and a dense clump.
+    points.extend_from_within(0..50);
+    points.extend((0..200).map(|i| [0.5, 0.5, 1e-4 * (i % 7) as f32]));
+    let index = Index::build(kind, &points);
+    let mut out = Vec::new();
+    for i in 0..100 {
+        let q = if i % 2 == 0 {
+            Vec3::from(crate::bench::point_on_unit_cube(&mut rng))
+        } else {
+            Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 1.2 - 0.1
+        };
+        for k in [1, 10, 50, 250] {
+            for r_max in [f32::INFINITY, 0.05] {
+                check(&index, &points, q, k, r_max, &mut out);
+            }
+        }
+    }
+    check(
+        &index,
+        &points,
+        Vec3::new(0.5, 0.5, 0.0),
+        100,
+        f32::INFINITY,
+        &mut out,
+    );
+});
+
+each_index!(duplicates_all_at_one_point, |kind: IndexKind| {
+    let points = vec![[0.25f32, -1.0, 3.0]; 1000];
+    let index = Index::build(kind, &points);
+    let mut out = Vec::new();
+    for q in [Vec3::new(0.25, -1.0, 3.0), Vec3::ZERO, Vec3::splat(1e6)] {
+        for k in [1, 10, 999, 1000, 1500] {
+            for r_max in [f32::INFINITY, 0.5, 0.0] {
+                check(&index, &points, q, k, r_max, &mut out);
+            }
+        }
+    }
+});
+
+each_index!(
+    photon_map_indices_point_at_its_photons,
+    |kind: IndexKind| {
+        let mut rng = Rng::new(3);
+        let photons: Vec<Photon> = (0..2000)
+            .map(|i| {
+                let p = Vec3::from(crate::bench::point_on_unit_cube(&mut rng));
+                Photon::new(p, Vec3::splat(i as f32), -Vec3::Y, i)
+            })
+            .collect();
+        let map = PhotonMap::build(photons.clone(), 1, kind);
+        let mut out = Vec::new();
+        let q = Vec3::new(0.3, 0.0, 0.6);
+        map.knn(q, 20, f32::INFINITY, &mut out);
+        assert_eq!(out.len(), 20);
+        for nb in &out {
+            let ph = &map.photons()[nb.index as usize];
+            assert_eq!(dist2(ph.pos, q.to_array()), nb.d2);
+            // The record moved as a whole: its power still names its original slot.
+            assert_eq!(photons[ph.surface as usize], *ph);
+        }
+    }
+);
