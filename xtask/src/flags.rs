@@ -34,7 +34,10 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
     match a.as_slice() {
         [] | ["help" | "-h" | "--help", ..] => Ok(Cmd::Help),
         ["gen-scenes"] => Ok(Cmd::GenScenes),
-        [cmd @ ("info" | "render" | "compare" | "trace"), rest @ ..] => Ok(Cmd::Photonflow(
+        [
+            cmd @ ("info" | "render" | "compare" | "trace" | "estimate"),
+            rest @ ..,
+        ] => Ok(Cmd::Photonflow(
             std::iter::once(*cmd)
                 .chain(rest.iter().copied())
                 .map(String::from)

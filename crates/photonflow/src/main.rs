@@ -3,6 +3,7 @@
 //! nothing here panics on bad input.
 
 mod bench;
+mod estimate;
 mod pipeline;
 mod progress;
 mod render;
@@ -36,11 +37,14 @@ enum Cmd {
         #[arg(long)]
         compare: bool,
     },
-    /// Render an image. `--method path` is the path-traced reference.
+    /// Render an image. `--method path` is the path-traced reference; `global-direct` and
+    /// `final-gather` chain trace (or reuse the cached photons) and estimate.
     Render {
         scene: PathBuf,
         #[arg(long, default_value = "path")]
         method: String,
+        #[command(flatten)]
+        photon: PhotonArgs,
         /// Samples per pixel (default: the scene file's render.spp).
         #[arg(long)]
         spp: Option<u32>,
@@ -54,6 +58,23 @@ enum Cmd {
         #[arg(long)]
         out: Option<PathBuf>,
         /// Exposure of the PNG in stops.
+        #[arg(long, default_value_t = 0.0)]
+        exposure: f32,
+    },
+    /// Estimate an image from cached photon sets (never traces).
+    Estimate {
+        scene: PathBuf,
+        /// global-direct (the global map shown directly) or final-gather.
+        #[arg(long, default_value = "global-direct")]
+        method: String,
+        #[command(flatten)]
+        photon: PhotonArgs,
+        #[arg(long)]
+        spp: Option<u32>,
+        #[arg(long)]
+        threads: Option<usize>,
+        #[arg(long)]
+        out: Option<PathBuf>,
         #[arg(long, default_value_t = 0.0)]
         exposure: f32,
     },
@@ -80,6 +101,75 @@ enum Cmd {
         #[arg(long, value_parser = parse_rect)]
         mask: Option<[usize; 4]>,
     },
+}
+
+/// Photon-mapping settings shared by `estimate` and `render`.
+#[derive(clap::Args)]
+struct PhotonArgs {
+    /// Photon paths emitted (default: the scene's [photons] table).
+    #[arg(long)]
+    photons: Option<u64>,
+    #[arg(long, default_value = "out/cache")]
+    cache: PathBuf,
+    /// Nearest photons per global-map estimate (default: [estimate.global] k, else 1000).
+    #[arg(long)]
+    k: Option<usize>,
+    /// Kernel of the global-map estimate: uniform, silverman, epanechnikov, triweight,
+    /// gaussian, gaussian-jensen, cone, cone:K.
+    #[arg(long, value_parser = estimate::parse_kernel)]
+    kernel: Option<density::Kernel>,
+    /// Topological test: keep photons whose direction from the estimation point is within
+    /// |cos| < EPS of the tangent plane.
+    #[arg(long)]
+    topo: Option<f32>,
+    /// Drop the k-th photon (Garcia et al. 2012).
+    #[arg(long)]
+    drop_kth: bool,
+    /// Final-gather rays per sample.
+    #[arg(long, default_value_t = 16)]
+    gather_rays: u32,
+    /// Compare with this linear EXR (the path-traced reference) and record the error.
+    #[arg(long)]
+    reference: Option<PathBuf>,
+    /// Name of the output directory's method part.
+    #[arg(long)]
+    label: Option<String>,
+}
+
+fn photon_method(name: &str, rays: u32) -> Result<eye::PhotonMethod, String> {
+    match name {
+        "global-direct" => Ok(eye::PhotonMethod::GlobalDirect),
+        "final-gather" => Ok(eye::PhotonMethod::FinalGather { rays }),
+        other => Err(format!(
+            "unknown photon method `{other}` (global-direct, final-gather)"
+        )),
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn estimate_args(
+    method: eye::PhotonMethod,
+    p: PhotonArgs,
+    spp: Option<u32>,
+    threads: Option<usize>,
+    out: Option<PathBuf>,
+    exposure: f32,
+) -> estimate::EstimateArgs {
+    estimate::EstimateArgs {
+        method,
+        photons: p.photons,
+        cache: p.cache,
+        spp,
+        threads,
+        out,
+        k: p.k,
+        kernel: p.kernel,
+        topo: p.topo,
+        drop_kth: p.drop_kth,
+        reference: p.reference,
+        exposure,
+        label: p.label,
+    }
 }
 
 fn parse_rect(s: &str) -> Result<[usize; 4], String> {
@@ -120,6 +210,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
         Cmd::Render {
             scene,
             method,
+            photon,
             spp,
             no_caustics,
             threads,
@@ -134,8 +225,46 @@ fn run(cmd: Cmd) -> Result<(), String> {
                 out,
                 exposure,
             }),
-            other => Err(format!("unknown --method `{other}` (known: path)")),
+            m => {
+                let method =
+                    photon_method(m, photon.gather_rays).map_err(|e| format!("{e}; or `path`"))?;
+                let s = scene::Scene::load(&scene).map_err(|e| e.to_string())?;
+                let t = trace::trace(
+                    &s,
+                    &trace::TraceArgs {
+                        photons: photon.photons,
+                        cache: photon.cache.clone(),
+                        threads,
+                        force: false,
+                    },
+                )?;
+                let e = estimate::estimate(
+                    &s,
+                    &estimate_args(method, photon, spp, threads, out, exposure),
+                )?;
+                println!(
+                    "pipeline: trace {} ({:.2} s) + estimate {:.2} s",
+                    if t.reused { "reused" } else { "traced" },
+                    t.seconds,
+                    e.seconds
+                );
+                Ok(())
+            }
         },
+        Cmd::Estimate {
+            scene,
+            method,
+            photon,
+            spp,
+            threads,
+            out,
+            exposure,
+        } => {
+            let m = photon_method(&method, photon.gather_rays)?;
+            let s = scene::Scene::load(&scene).map_err(|e| e.to_string())?;
+            estimate::estimate(&s, &estimate_args(m, photon, spp, threads, out, exposure))
+                .map(|_| ())
+        }
         Cmd::Compare { a, b, mask } => render::compare(&a, &b, mask),
         Cmd::Trace {
             scene,

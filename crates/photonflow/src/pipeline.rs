@@ -140,7 +140,10 @@ pub fn run(
             key.params_hash,
             key.params_json.clone(),
         );
-        writers.push((*kind, StoreWriter::create(path, header).map_err(|e| e.to_string())?));
+        writers.push((
+            *kind,
+            StoreWriter::create(path, header).map_err(|e| e.to_string())?,
+        ));
     }
     let ranges: Vec<std::ops::Range<u64>> = emit::chunks(params.photons, opts.chunk).collect();
     let n = ranges.len();

@@ -61,22 +61,11 @@ pub fn path(a: RenderArgs) -> Result<(), String> {
             .resolve(Normalize::Constant(spp as f64));
         layers.push((name.to_string(), img));
     }
-    let parts: Vec<(&Image, f32)> = layers.iter().map(|(_, i)| (i, 1.0)).collect();
-    let image = film::composite(&parts).map_err(|e| e.to_string())?;
+    let image = write_outputs(&out, &layers, a.exposure)?;
     let tone = ToneMap {
         exposure: a.exposure,
         ..ToneMap::default()
     };
-    std::fs::create_dir_all(out.join("layers"))
-        .map_err(|e| format!("{}: cannot create output directory: {e}", out.display()))?;
-    let exr = out.join("image.exr");
-    let png = out.join("image.png");
-    film::write_exr(&exr, &image).map_err(|e| e.to_string())?;
-    film::write_png(&png, &image, &tone).map_err(|e| e.to_string())?;
-    for (name, img) in &layers {
-        film::write_exr(out.join("layers").join(format!("{name}.exr")), img)
-            .map_err(|e| e.to_string())?;
-    }
     let json = serde_json::json!({
         "scene": a.scene.display().to_string(),
         "scene_hash": format!("{:016x}", s.content_hash),
@@ -104,12 +93,36 @@ pub fn path(a: RenderArgs) -> Result<(), String> {
         samples as f64 / secs / 1e6
     );
     println!(
-        "wrote {} (linear), {} (gamma {}), layers/ and image.json",
-        exr.display(),
-        png.display(),
+        "wrote {}/image.exr (linear), image.png (gamma {}), layers/ and image.json",
+        out.display(),
         tone.gamma
     );
+    let _ = image;
     Ok(())
+}
+
+/// Writes the sum of `layers` as `image.exr` (linear) and `image.png` (tone-mapped), and each
+/// layer as `layers/<name>.exr`; returns the sum.
+pub fn write_outputs(
+    out: &Path,
+    layers: &[(String, Image)],
+    exposure: f32,
+) -> Result<Image, String> {
+    let parts: Vec<(&Image, f32)> = layers.iter().map(|(_, i)| (i, 1.0)).collect();
+    let image = film::composite(&parts).map_err(|e| e.to_string())?;
+    let tone = ToneMap {
+        exposure,
+        ..ToneMap::default()
+    };
+    std::fs::create_dir_all(out.join("layers"))
+        .map_err(|e| format!("{}: cannot create output directory: {e}", out.display()))?;
+    film::write_exr(out.join("image.exr"), &image).map_err(|e| e.to_string())?;
+    film::write_png(out.join("image.png"), &image, &tone).map_err(|e| e.to_string())?;
+    for (name, img) in layers {
+        film::write_exr(out.join("layers").join(format!("{name}.exr")), img)
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(image)
 }
 
 pub fn compare(a: &Path, b: &Path, mask: Option<[usize; 4]>) -> Result<(), String> {

@@ -41,18 +41,26 @@ pub fn params(scene: &Scene, photons: Option<u64>) -> Result<EmitParams, String>
 
 pub fn trace(scene: &Scene, a: &TraceArgs) -> Result<TraceOutput, String> {
     let params = params(scene, a.photons)?;
-    let plan = Plan::for_scene(scene, &params).map_err(|e| format!("{}: {e}", scene.path.display()))?;
+    let plan =
+        Plan::for_scene(scene, &params).map_err(|e| format!("{}: {e}", scene.path.display()))?;
     print!("{plan}");
     let key = CacheKey::new(scene, &params);
     let kinds = pipeline::planned_kinds(&plan);
-    let files: Vec<(MapKind, PathBuf)> = kinds.iter().map(|&k| (k, key.file(&a.cache, k))).collect();
+    let files: Vec<(MapKind, PathBuf)> =
+        kinds.iter().map(|&k| (k, key.file(&a.cache, k))).collect();
     save_plan(&a.cache, &key, &plan)?;
     if !a.force && pipeline::cached(&a.cache, &key, &kinds) {
         println!("reused cached photon sets (no tracing):");
         for (_, f) in &files {
             println!("  {}", f.display());
         }
-        return Ok(TraceOutput { files, reused: true, plan, params, seconds: 0.0 });
+        return Ok(TraceOutput {
+            files,
+            reused: true,
+            plan,
+            params,
+            seconds: 0.0,
+        });
     }
     let threads = a.threads.unwrap_or_else(rayon::current_num_threads);
     if threads == 0 {
@@ -87,12 +95,21 @@ pub fn trace(scene: &Scene, a: &TraceArgs) -> Result<TraceOutput, String> {
     for (_, f) in &files {
         println!("  {}", f.display());
     }
-    Ok(TraceOutput { files, reused: false, plan, params, seconds: stats.seconds })
+    Ok(TraceOutput {
+        files,
+        reused: false,
+        plan,
+        params,
+        seconds: stats.seconds,
+    })
 }
 
 fn save_plan(dir: &Path, key: &CacheKey, plan: &Plan) -> Result<(), String> {
     std::fs::create_dir_all(dir)
         .map_err(|e| format!("{}: cannot create cache directory: {e}", dir.display()))?;
-    let path = dir.join(format!("{:016x}-{:016x}-plan.txt", key.scene_hash, key.params_hash));
+    let path = dir.join(format!(
+        "{:016x}-{:016x}-plan.txt",
+        key.scene_hash, key.params_hash
+    ));
     film::write_atomic(&path, plan.to_string().as_bytes()).map_err(|e| e.to_string())
 }

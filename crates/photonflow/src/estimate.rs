@@ -1,0 +1,297 @@
+//! `estimate`: the density stage on cached photon sets. It never traces: a missing or stale
+//! set is an error that says to run `trace` first, so swapping the estimator costs only the
+//! estimate (issue 5: "swap the estimator stage alone").
+
+use crate::pipeline::{self, CacheKey};
+use crate::progress::Progress;
+use density::{EstimateParams, IndexKind, Kernel, Neighbor, PhotonMap};
+use eye::{Irradiance, MapLookup, PhotonMethod, RenderOptions};
+use film::{Image, Normalize};
+use glam::Vec3;
+use scene::Scene;
+use std::cell::RefCell;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use store::{MapKind, MappedStore};
+
+/// Settings of one estimate, from the scene's `[estimate.global]` / `[estimate.caustic]`
+/// tables with command-line overrides applied to the global map's.
+pub struct EstimateArgs {
+    pub method: PhotonMethod,
+    pub photons: Option<u64>,
+    pub cache: PathBuf,
+    pub spp: Option<u32>,
+    pub threads: Option<usize>,
+    pub out: Option<PathBuf>,
+    pub k: Option<usize>,
+    pub kernel: Option<Kernel>,
+    pub topo: Option<f32>,
+    pub drop_kth: bool,
+    pub reference: Option<PathBuf>,
+    pub exposure: f32,
+    pub label: Option<String>,
+}
+
+pub fn parse_kernel(s: &str) -> Result<Kernel, String> {
+    Ok(match s {
+        "uniform" | "box" => Kernel::Uniform,
+        "silverman" | "simpson" => Kernel::Silverman,
+        "epanechnikov" => Kernel::Epanechnikov,
+        "triweight" => Kernel::Triweight,
+        "gaussian" => Kernel::Gaussian,
+        "gaussian-jensen" => Kernel::GaussianJensen,
+        "cone" => Kernel::Cone { k: 1.0 },
+        _ => match s.strip_prefix("cone:").map(str::parse::<f32>) {
+            Some(Ok(k)) if k >= 1.0 && k.is_finite() => Kernel::Cone { k },
+            _ => {
+                return Err(format!(
+                    "unknown kernel `{s}` (uniform, silverman, epanechnikov, triweight, gaussian, \
+                     gaussian-jensen, cone, cone:K with K >= 1)"
+                ));
+            }
+        },
+    })
+}
+
+pub fn kernel_name(k: Kernel) -> String {
+    match k {
+        Kernel::Uniform => "uniform".into(),
+        Kernel::Silverman => "silverman".into(),
+        Kernel::Epanechnikov => "epanechnikov".into(),
+        Kernel::Triweight => "triweight".into(),
+        Kernel::Gaussian => "gaussian".into(),
+        Kernel::GaussianJensen => "gaussian-jensen".into(),
+        Kernel::Cone { k } => format!("cone:{k}"),
+    }
+}
+
+/// Defaults of the course framework (scene-facts.md): k = 1000 for the global map, 250 for
+/// the caustic map, box kernel, same-side test.
+fn map_params(scene: &Scene, which: &str, default_k: usize) -> Result<EstimateParams, String> {
+    let table = scene
+        .file
+        .estimate
+        .get(which)
+        .cloned()
+        .unwrap_or_else(|| toml::Value::Table(toml::Table::new()));
+    let mut t = match table {
+        toml::Value::Table(t) => t,
+        other => {
+            return Err(format!(
+                "{}: [estimate.{which}] must be a table, not {other}",
+                scene.path.display()
+            ));
+        }
+    };
+    t.entry("k")
+        .or_insert(toml::Value::Integer(default_k as i64));
+    toml::Value::Table(t)
+        .try_into()
+        .map_err(|e| format!("{}: [estimate.{which}]: {e}", scene.path.display()))
+}
+
+pub fn params(scene: &Scene, a: &EstimateArgs) -> Result<(EstimateParams, EstimateParams), String> {
+    for key in scene.file.estimate.keys() {
+        if key != "global" && key != "caustic" {
+            return Err(format!(
+                "{}: [estimate] has unknown table `{key}` (known: global, caustic)",
+                scene.path.display()
+            ));
+        }
+    }
+    let mut g = map_params(scene, "global", 1000)?;
+    let c = map_params(scene, "caustic", 250)?;
+    if let Some(k) = a.k {
+        g.k = k;
+    }
+    if let Some(kern) = a.kernel {
+        g.kernel = kern;
+    }
+    if let Some(eps) = a.topo {
+        g.topo = Some(eps);
+    }
+    g.drop_kth |= a.drop_kth;
+    for (name, p) in [("global", &g), ("caustic", &c)] {
+        if p.k == 0 || p.k > 1 << 20 {
+            return Err(format!(
+                "estimate.{name}.k = {} must be in 1..=1048576",
+                p.k
+            ));
+        }
+        if let Some(eps) = p.topo
+            && !(eps > 0.0 && eps <= 1.0)
+        {
+            return Err(format!("estimate.{name}.topo = {eps} must be in (0, 1]"));
+        }
+    }
+    Ok((g, c))
+}
+
+/// The photon maps behind [`eye::Irradiance`], with a per-thread neighbour buffer.
+struct Maps {
+    global: Option<PhotonMap>,
+    caustic: Option<PhotonMap>,
+    gp: EstimateParams,
+    cp: EstimateParams,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Vec<Neighbor>> = const { RefCell::new(Vec::new()) };
+}
+
+impl Irradiance for Maps {
+    fn irradiance(&self, map: MapLookup, p: Vec3, n: Vec3) -> Vec3 {
+        let (m, params) = match map {
+            MapLookup::Global => (&self.global, &self.gp),
+            MapLookup::Caustic => (&self.caustic, &self.cp),
+        };
+        let Some(m) = m else { return Vec3::ZERO };
+        SCRATCH.with_borrow_mut(|s| m.irradiance(p, n, params, s))
+    }
+}
+
+fn load_map(path: &Path, key: &CacheKey, kind: MapKind) -> Result<PhotonMap, String> {
+    let store = MappedStore::open(path).map_err(|e| e.to_string())?;
+    store.check(&key.expect(kind)).map_err(|e| e.to_string())?;
+    // Photon powers from `emit` already carry the 1/N of the emitted count the header records,
+    // so the map divides by 1.
+    Ok(PhotonMap::build(store.to_vec(), 1, IndexKind::KdTree))
+}
+
+pub struct EstimateOutput {
+    pub out: PathBuf,
+    pub seconds: f64,
+    pub metrics: Option<film::Metrics>,
+}
+
+pub fn estimate(scene: &Scene, a: &EstimateArgs) -> Result<EstimateOutput, String> {
+    let t0 = Instant::now();
+    let emit_params = crate::trace::params(scene, a.photons)?;
+    let plan = emit::Plan::for_scene(scene, &emit_params)
+        .map_err(|e| format!("{}: {e}", scene.path.display()))?;
+    let key = CacheKey::new(scene, &emit_params);
+    let needed: Vec<MapKind> = match a.method {
+        PhotonMethod::GlobalDirect => vec![MapKind::Global],
+        PhotonMethod::FinalGather { .. } => pipeline::planned_kinds(&plan),
+    };
+    if needed.contains(&MapKind::Global) && !plan.global {
+        return Err(format!(
+            "{}: the effects plan traces no global photons",
+            scene.path.display()
+        ));
+    }
+    let mut global = None;
+    let mut caustic = None;
+    for kind in needed {
+        let path = key.file(&a.cache, kind);
+        if !path.exists() {
+            return Err(format!(
+                "{}: no cached photon set for this scene and these parameters; run `trace` first",
+                path.display()
+            ));
+        }
+        let m = load_map(&path, &key, kind)?;
+        match kind {
+            MapKind::Global => global = Some(m),
+            MapKind::Caustic => caustic = Some(m),
+        }
+    }
+    let t_load = t0.elapsed().as_secs_f64();
+    let (gp, cp) = params(scene, a)?;
+    let maps = Maps {
+        global,
+        caustic,
+        gp,
+        cp,
+    };
+    let spp = a.spp.unwrap_or(1);
+    if spp == 0 || spp > 1 << 20 {
+        return Err(format!("--spp {spp} must be in 1..=1048576"));
+    }
+    let opts = RenderOptions {
+        spp,
+        caustics: true,
+        threads: a.threads,
+        tile: scene.render().tile,
+    };
+    let (w, h) = (scene.camera.width as u64, scene.camera.height as u64);
+    let method_name = match a.method {
+        PhotonMethod::GlobalDirect => "global-direct".to_string(),
+        PhotonMethod::FinalGather { rays } => format!("final-gather-{rays}"),
+    };
+    let progress = Progress::new("estimate", w * h * spp as u64, "samples");
+    let t1 = Instant::now();
+    let film = eye::render_photon_map(scene, &opts, a.method, &maps, &|n| progress.inc(n));
+    let t_render = t1.elapsed().as_secs_f64();
+    progress.finish();
+
+    let label = a.label.clone().unwrap_or_else(|| method_name.clone());
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| crate::render::default_out(&scene.path, &label));
+    let layers: Vec<(String, Image)> = film
+        .layer_names()
+        .into_iter()
+        .map(|n| {
+            let img = film
+                .layer(n)
+                .expect("listed")
+                .resolve(Normalize::Constant(spp as f64));
+            (n.to_string(), img)
+        })
+        .collect();
+    let image = crate::render::write_outputs(&out, &layers, a.exposure)?;
+    let metrics = match &a.reference {
+        Some(r) => {
+            let reference = film::read_exr(r).map_err(|e| e.to_string())?;
+            Some(film::metrics(&image, &reference, None).map_err(|e| e.to_string())?)
+        }
+        None => None,
+    };
+    let seconds = t0.elapsed().as_secs_f64();
+    let json = serde_json::json!({
+        "scene": scene.path.display().to_string(),
+        "scene_hash": format!("{:016x}", scene.content_hash),
+        "method": method_name,
+        "label": label,
+        "spp": spp,
+        "photons_emitted": emit_params.photons,
+        "global_photons": maps.global.as_ref().map_or(0, |m| m.len()),
+        "caustic_photons": maps.caustic.as_ref().map_or(0, |m| m.len()),
+        "global_estimate": maps.gp,
+        "caustic_estimate": maps.cp,
+        "kernel": kernel_name(maps.gp.kernel),
+        "time_load_and_index_s": t_load,
+        "time_render_s": t_render,
+        "time_total_s": seconds,
+        "reference": a.reference.as_ref().map(|p| p.display().to_string()),
+        "rmse": metrics.as_ref().map(|m| m.rmse),
+        "relmse": metrics.as_ref().map(|m| m.relmse),
+        "mae": metrics.as_ref().map(|m| m.mae),
+        "mean": metrics.as_ref().map(|m| m.mean_a),
+        "mean_reference": metrics.as_ref().map(|m| m.mean_b),
+    });
+    let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
+    film::write_atomic(&out.join("image.json"), text.as_bytes()).map_err(|e| e.to_string())?;
+    film::write_atomic(&out.join("plan.txt"), plan.to_string().as_bytes())
+        .map_err(|e| e.to_string())?;
+    println!(
+        "estimated {label}: {}x{} at {spp} spp in {t_render:.2} s (+{t_load:.2} s loading and indexing {} photons)",
+        w,
+        h,
+        maps.global.as_ref().map_or(0, |m| m.len()) + maps.caustic.as_ref().map_or(0, |m| m.len())
+    );
+    if let Some(m) = &metrics {
+        println!("against the reference: {m}");
+    }
+    println!(
+        "wrote {}/image.{{exr,png,json}}, layers/, plan.txt",
+        out.display()
+    );
+    Ok(EstimateOutput {
+        out,
+        seconds,
+        metrics,
+    })
+}
