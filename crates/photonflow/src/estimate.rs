@@ -159,9 +159,7 @@ fn load_map(path: &Path, key: &CacheKey, kind: MapKind) -> Result<PhotonMap, Str
 }
 
 pub struct EstimateOutput {
-    pub out: PathBuf,
     pub seconds: f64,
-    pub metrics: Option<film::Metrics>,
 }
 
 pub fn estimate(scene: &Scene, a: &EstimateArgs) -> Result<EstimateOutput, String> {
@@ -289,9 +287,5 @@ pub fn estimate(scene: &Scene, a: &EstimateArgs) -> Result<EstimateOutput, Strin
         "wrote {}/image.{{exr,png,json}}, layers/, plan.txt",
         out.display()
     );
-    Ok(EstimateOutput {
-        out,
-        seconds,
-        metrics,
-    })
+    Ok(EstimateOutput { seconds })
 }

@@ -9,6 +9,9 @@ mod progress;
 mod render;
 mod trace;
 
+#[cfg(test)]
+mod tests;
+
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;

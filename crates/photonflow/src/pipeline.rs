@@ -11,7 +11,7 @@ use scene::Scene;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use store::{Expect, Header, MapKind, StoreReader, StoreWriter};
+use store::{Expect, Header, MapKind, MappedStore, StoreWriter};
 
 /// Where the photon sets of one (scene, parameters) pair live in a cache directory.
 pub struct CacheKey {
@@ -69,7 +69,7 @@ pub fn emit_params(scene: &Scene) -> Result<EmitParams, String> {
         .map_err(|e| format!("{}: [photons]: {e}", scene.path.display()))
 }
 
-/// Whether every planned set is in the cache, valid and made for exactly this key.
+/// Whether every planned set is in the cache, intact and made for exactly this key.
 /// A file that exists but fails to open is reported and traced anew.
 pub fn cached(dir: &Path, key: &CacheKey, kinds: &[MapKind]) -> bool {
     kinds.iter().all(|&k| {
@@ -77,7 +77,9 @@ pub fn cached(dir: &Path, key: &CacheKey, kinds: &[MapKind]) -> bool {
         if !path.exists() {
             return false;
         }
-        match StoreReader::open(&path).and_then(|r| r.check(&key.expect(k))) {
+        // Mapping checks every chunk's checksum (several GB/s), so a damaged file is traced
+        // anew instead of failing later in the estimate.
+        match MappedStore::open(&path).and_then(|r| r.check(&key.expect(k))) {
             Ok(()) => true,
             Err(e) => {
                 eprintln!("warning: cached photon set unusable, tracing anew: {e}");
@@ -102,6 +104,8 @@ pub struct PipelineOptions {
     pub chunk: u64,
     /// Chunks alive at most.
     pub window: usize,
+    /// Receives every chunk, in index order, after it is written (a consuming stage).
+    pub consumer: Option<Sender<Arc<Traced>>>,
 }
 
 impl PipelineOptions {
@@ -110,12 +114,13 @@ impl PipelineOptions {
             threads: threads.max(1),
             chunk: 16_384,
             window: 2 * threads.max(1) + 2,
+            consumer: None,
         }
     }
 }
 
 /// Traces `params.photons` paths and writes the planned sets to `files` (one per kind, in
-/// `planned_kinds` order), forwarding every chunk, in index order, to `consumer` if given.
+/// `planned_kinds` order), forwarding every chunk, in index order, to `opts.consumer`.
 pub fn run(
     scene: &Scene,
     params: &EmitParams,
@@ -123,7 +128,6 @@ pub fn run(
     key: &CacheKey,
     files: &[(MapKind, PathBuf)],
     opts: &PipelineOptions,
-    consumer: Option<Sender<Arc<Traced>>>,
     progress: &Progress,
 ) -> Result<TraceStats, String> {
     let start = std::time::Instant::now();
@@ -183,7 +187,7 @@ pub fn run(
                     w.write(photons).map_err(|e| e.to_string())?;
                 }
                 progress.inc(traced.emitted);
-                if let Some(c) = &consumer {
+                if let Some(c) = &opts.consumer {
                     // A consumer that hung up only loses its copy; the files are still written.
                     let _ = c.send(Arc::new(traced));
                 }

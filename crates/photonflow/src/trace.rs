@@ -17,10 +17,7 @@ pub struct TraceArgs {
 
 /// What the stage produced: the photon files per kind, and whether they were reused.
 pub struct TraceOutput {
-    pub files: Vec<(MapKind, PathBuf)>,
     pub reused: bool,
-    pub plan: Plan,
-    pub params: EmitParams,
     pub seconds: f64,
 }
 
@@ -55,10 +52,7 @@ pub fn trace(scene: &Scene, a: &TraceArgs) -> Result<TraceOutput, String> {
             println!("  {}", f.display());
         }
         return Ok(TraceOutput {
-            files,
             reused: true,
-            plan,
-            params,
             seconds: 0.0,
         });
     }
@@ -74,7 +68,6 @@ pub fn trace(scene: &Scene, a: &TraceArgs) -> Result<TraceOutput, String> {
         &key,
         &files,
         &PipelineOptions::new(threads),
-        None,
         &progress,
     )?;
     progress.finish();
@@ -84,10 +77,11 @@ pub fn trace(scene: &Scene, a: &TraceArgs) -> Result<TraceOutput, String> {
         .sum();
     let stored = stats.stored[0] + stats.stored[1];
     println!(
-        "traced {} photon paths in {:.2} s ({:.3} M paths/s on {threads} threads); stored {} global, {} caustic ({:.1} bytes/photon)",
+        "traced {} photon paths in {:.2} s ({:.3} M paths/s on {threads} threads, at most {} chunks in memory); stored {} global, {} caustic ({:.1} bytes/photon)",
         stats.emitted,
         stats.seconds,
         stats.emitted as f64 / stats.seconds / 1e6,
+        stats.max_in_flight,
         stats.stored[0],
         stats.stored[1],
         bytes as f64 / stored.max(1) as f64
@@ -96,10 +90,7 @@ pub fn trace(scene: &Scene, a: &TraceArgs) -> Result<TraceOutput, String> {
         println!("  {}", f.display());
     }
     Ok(TraceOutput {
-        files,
         reused: false,
-        plan,
-        params,
         seconds: stats.seconds,
     })
 }

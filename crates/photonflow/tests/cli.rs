@@ -221,3 +221,116 @@ fn compare_refuses_missing_files_and_bad_masks() {
     let o = photonflow(&["compare", "a.exr", "b.exr", "--mask", "1,2,3"]);
     assert_eq!(o.status.code(), Some(2), "usage error");
 }
+
+#[test]
+fn swapping_the_estimator_reads_the_cache_and_never_traces() {
+    let dir = Scratch::new("swap", &[]);
+    let cache = dir.0.join("cache");
+    let cache_s = cache.to_str().unwrap();
+    let scene = "scenes/corner/corner.toml";
+    // Without a traced set, estimate refuses instead of tracing.
+    let o = photonflow(&["estimate", scene, "--photons", "20000", "--cache", cache_s]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains("run `trace` first"), "{e}");
+    assert!(!cache.join("x").exists());
+
+    let o = photonflow(&["trace", scene, "--photons", "20000", "--cache", cache_s]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("caustic photons: skipped"),
+        "corner has no specular surface: {text}"
+    );
+    let files: Vec<PathBuf> = std::fs::read_dir(&cache)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "photons"))
+        .collect();
+    assert_eq!(files.len(), 1, "only the global set: {files:?}");
+    let before = std::fs::metadata(&files[0]).unwrap().modified().unwrap();
+    let bytes = std::fs::read(&files[0]).unwrap();
+
+    let mut outs = Vec::new();
+    for kernel in ["uniform", "silverman"] {
+        let out = dir.0.join(kernel);
+        let o = photonflow(&[
+            "estimate",
+            scene,
+            "--photons",
+            "20000",
+            "--cache",
+            cache_s,
+            "--k",
+            "50",
+            "--kernel",
+            kernel,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        outs.push(std::fs::read(out.join("image.exr")).unwrap());
+        let json = std::fs::read_to_string(out.join("image.json")).unwrap();
+        assert!(
+            json.contains(&format!("\"kernel\": \"{kernel}\"")),
+            "{json}"
+        );
+    }
+    assert_ne!(outs[0], outs[1], "another kernel, another image");
+    // The photon set was read, never rewritten.
+    assert_eq!(
+        std::fs::metadata(&files[0]).unwrap().modified().unwrap(),
+        before
+    );
+    assert_eq!(std::fs::read(&files[0]).unwrap(), bytes);
+
+    // render chains trace and estimate, and reuses the cached set.
+    let o = photonflow(&[
+        "render",
+        scene,
+        "--method",
+        "global-direct",
+        "--photons",
+        "20000",
+        "--cache",
+        cache_s,
+        "--k",
+        "50",
+        "--out",
+        dir.0.join("r").to_str().unwrap(),
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success() && text.contains("reused cached photon sets"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_truncated_cache_file_is_traced_anew() {
+    let dir = Scratch::new("trunc", &[]);
+    let cache = dir.0.join("cache");
+    let cache_s = cache.to_str().unwrap();
+    let scene = "scenes/corner/corner.toml";
+    let o = photonflow(&["trace", scene, "--photons", "5000", "--cache", cache_s]);
+    assert!(o.status.success());
+    let f = std::fs::read_dir(&cache)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|x| x == "photons"))
+        .unwrap();
+    let good = std::fs::read(&f).unwrap();
+    std::fs::write(&f, &good[..good.len() - 7]).unwrap();
+    let o = photonflow(&["trace", scene, "--photons", "5000", "--cache", cache_s]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("unusable") && err.contains("truncated"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(&f).unwrap(),
+        good,
+        "traced again, bit for bit"
+    );
+}
