@@ -14,6 +14,12 @@ cargo xtask <command>
   trace SCENE [--photons N] [--cache DIR] [--threads N] [--force]
                       trace the photon sets the scene's effects plan asks for into the cache,
                       or reuse them when the scene and parameters are unchanged
+  bench photons [SCENE] [--photons N] [--runs N]
+                      photon paths/s on 1 and 2 threads (tracing alone and into photon files)
+  bench store [--photons N]
+                      write/read GB/s of a 10M-photon file; plain records against bincode
+  bench knn [--photons N] [--queries N]
+                      k-NN queries/s for k = 50, 250, 1000 per index (kd-tree, kiddo, brute)
   info SCENE          load a scene and print what it holds
   gen-scenes          rewrite the generated OBJ/MTL files under scenes/
 ";
@@ -51,6 +57,19 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
             out.extend(rest.iter().map(|s| s.to_string()));
             Ok(Cmd::Bench(out))
         }
+        ["bench", "photons", rest @ ..] => {
+            let mut out = vec!["bench-photons".to_string()];
+            if rest.first().is_none_or(|s| s.starts_with("--")) {
+                out.push(DEFAULT_SCENE.into());
+            }
+            out.extend(rest.iter().map(|s| s.to_string()));
+            Ok(Cmd::Bench(out))
+        }
+        ["bench", kind @ ("store" | "knn"), rest @ ..] => Ok(Cmd::Bench(
+            std::iter::once(format!("bench-{kind}"))
+                .chain(rest.iter().map(|s| s.to_string()))
+                .collect(),
+        )),
         [other, ..] => Err(format!("unknown command `{other}`\n\n{HELP}")),
     }
 }

@@ -66,7 +66,7 @@ fn photonflow(profile: &str, args: &[String]) -> Result<(), String> {
         .map(PathBuf::from)
         .unwrap_or_else(|| root.join("target"));
     let exe = target
-        .join("release")
+        .join(profile)
         .join(format!("photonflow{}", std::env::consts::EXE_SUFFIX));
     let status = Command::new(&exe)
         .current_dir(&root)

@@ -91,3 +91,124 @@ fn random_rays(geo: &Geometry, count: usize, seed: u64) -> Vec<Ray> {
         })
         .collect()
 }
+
+/// Photon paths per second through `emit::trace_range` on 1 and 2 threads (chunks of 16k
+/// paths handed out by index, as the pipeline does), and through the whole pipeline into
+/// photon files. Median of `runs`.
+pub fn photons(path: &Path, count: u64, runs: usize) -> Result<(), String> {
+    let s = scene::Scene::load(path).map_err(|e| e.to_string())?;
+    let mut params = crate::trace::params(&s, Some(count))?;
+    params.photons = count;
+    let plan = emit::Plan::for_scene(&s, &params).map_err(|e| e.to_string())?;
+    println!(
+        "scene {}, {count} photon paths per run, median of {runs} runs",
+        path.display()
+    );
+    for threads in [1usize, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| e.to_string())?;
+        let mut rates = Vec::new();
+        let mut stored = 0;
+        for _ in 0..runs.max(1) {
+            let t = Instant::now();
+            let chunks: Vec<_> = emit::chunks(count, 16_384).collect();
+            let traced: Vec<emit::Traced> = pool.install(|| {
+                use rayon::prelude::*;
+                chunks
+                    .par_iter()
+                    .map(|r| emit::trace_range(&s, &params, &plan, r.clone()))
+                    .collect()
+            });
+            rates.push(count as f64 / t.elapsed().as_secs_f64());
+            stored = traced
+                .iter()
+                .map(|t| t.global.len() + t.caustic.len())
+                .sum();
+        }
+        rates.sort_by(f64::total_cmp);
+        println!(
+            "trace only, {threads} thread(s): {:6.3} M paths/s ({:.2} stored photons per path)",
+            rates[rates.len() / 2] / 1e6,
+            stored as f64 / count as f64
+        );
+    }
+    let dir = std::env::temp_dir().join(format!("photonflow-bench-{}", std::process::id()));
+    for threads in [1usize, 2] {
+        let mut rates = Vec::new();
+        for _ in 0..runs.max(1) {
+            let key = crate::pipeline::CacheKey::new(&s, &params);
+            let files: Vec<_> = crate::pipeline::planned_kinds(&plan)
+                .into_iter()
+                .map(|k| (k, key.file(&dir, k)))
+                .collect();
+            let progress = crate::progress::Progress::hidden();
+            let stats = crate::pipeline::run(
+                &s,
+                &params,
+                &plan,
+                &key,
+                &files,
+                &crate::pipeline::PipelineOptions::new(threads),
+                &progress,
+            )?;
+            rates.push(count as f64 / stats.seconds);
+        }
+        rates.sort_by(f64::total_cmp);
+        println!(
+            "pipeline to photon files, {threads} thread(s): {:6.3} M paths/s",
+            rates[rates.len() / 2] / 1e6
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    Ok(())
+}
+
+/// Write and read throughput of a photon file, and plain records against bincode.
+pub fn store(photons: usize, dir: &Path) -> Result<(), String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let b = store::bench::bench_store(dir, photons).map_err(|e| e.to_string())?;
+    println!(
+        "photon file: {} photons, {} bytes ({:.4} bytes/photon) in {}",
+        b.photons,
+        b.file_bytes,
+        b.bytes_per_photon,
+        dir.display()
+    );
+    println!("   write (fsync + rename): {:6.2} GB/s", b.write_gbs);
+    println!(
+        "   write (page cache)    : {:6.2} GB/s",
+        b.write_unsynced_gbs
+    );
+    println!("   streaming read        : {:6.2} GB/s", b.stream_read_gbs);
+    println!("   mapped read (+ CRCs)  : {:6.2} GB/s", b.mapped_read_gbs);
+    let e = store::bench::bench_encodings(photons.min(10_000_000));
+    println!(
+        "encodings of {} photons: plain records encode {:.2} / decode {:.2} GB/s; bincode encode {:.2} / decode {:.2} GB/s ({} bytes); bincode fixint encode {:.2} / decode {:.2} GB/s",
+        e.photons,
+        e.plain_encode_gbs,
+        e.plain_decode_gbs,
+        e.bincode_encode_gbs,
+        e.bincode_decode_gbs,
+        e.bincode_bytes,
+        e.bincode_fixint_encode_gbs,
+        e.bincode_fixint_decode_gbs
+    );
+    Ok(())
+}
+
+/// k-NN queries per second over synthetic photons on the faces of a unit cube, per index.
+pub fn knn(photons: usize, queries: usize) -> Result<(), String> {
+    println!("{photons} photons on the unit cube's faces, {queries} queries, 1 thread");
+    for r in density::bench::bench_knn(photons, &[50, 250, 1000], queries, 7) {
+        println!(
+            "{:>8} k = {:4}: {:10.0} queries/s (build {:.3} s)",
+            r.index.name(),
+            r.k,
+            r.queries_per_s,
+            r.build_s
+        );
+    }
+    Ok(())
+}

@@ -40,6 +40,29 @@ enum Cmd {
         #[arg(long)]
         compare: bool,
     },
+    /// Photon paths/s on 1 and 2 threads, tracing only and through the pipeline to files.
+    BenchPhotons {
+        scene: PathBuf,
+        #[arg(long, default_value_t = 1_000_000)]
+        photons: u64,
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+    },
+    /// Write/read throughput of a photon file (default 10M photons), and encodings compared.
+    BenchStore {
+        #[arg(long, default_value_t = 10_000_000)]
+        photons: usize,
+        /// Directory for the temporary file.
+        #[arg(long, default_value = "out/bench")]
+        dir: PathBuf,
+    },
+    /// k-NN queries/s for k = 50, 250, 1000 for each index.
+    BenchKnn {
+        #[arg(long, default_value_t = 1_000_000)]
+        photons: usize,
+        #[arg(long, default_value_t = 20_000)]
+        queries: usize,
+    },
     /// Render an image. `--method path` is the path-traced reference; `global-direct` and
     /// `final-gather` chain trace (or reuse the cached photons) and estimate.
     Render {
@@ -269,6 +292,13 @@ fn run(cmd: Cmd) -> Result<(), String> {
                 .map(|_| ())
         }
         Cmd::Compare { a, b, mask } => render::compare(&a, &b, mask),
+        Cmd::BenchPhotons {
+            scene,
+            photons,
+            runs,
+        } => bench::photons(&scene, photons, runs),
+        Cmd::BenchStore { photons, dir } => bench::store(photons, &dir),
+        Cmd::BenchKnn { photons, queries } => bench::knn(photons, queries),
         Cmd::Trace {
             scene,
             photons,

@@ -38,6 +38,18 @@ impl Progress {
         }
     }
 
+    /// No output at all (benchmarks time the work, not the printing).
+    pub fn hidden() -> Progress {
+        Progress {
+            bar: None,
+            total: u64::MAX,
+            unit: "",
+            label: String::new(),
+            start: Instant::now(),
+            plain: Mutex::new((0, 11)),
+        }
+    }
+
     pub fn inc(&self, n: u64) {
         if let Some(b) = &self.bar {
             b.inc(n);
