@@ -20,6 +20,11 @@ cargo xtask <command>
                       write/read GB/s of a 10M-photon file; plain records against bincode
   bench knn [--photons N] [--queries N]
                       k-NN queries/s for k = 50, 250, 1000 per index (kd-tree, kiddo, brute)
+  estimate SCENE --method global-direct|final-gather [--k N] [--kernel K] [--topo EPS] [--drop-kth]
+                      estimate from the cached photon sets only (never traces)
+  worksheet [--photons N] [--k N] [--topo EPS] [--reference-spp N]
+                      worksheet 7's images (box kernel, Silverman, + topological test) with
+                      errors against a path-traced reference, summarised in out/worksheet/README.md
   info SCENE          load a scene and print what it holds
   gen-scenes          rewrite the generated OBJ/MTL files under scenes/
 ";

@@ -8,6 +8,7 @@ mod pipeline;
 mod progress;
 mod render;
 mod trace;
+mod worksheet;
 
 #[cfg(test)]
 mod tests;
@@ -103,6 +104,29 @@ enum Cmd {
         out: Option<PathBuf>,
         #[arg(long, default_value_t = 0.0)]
         exposure: f32,
+    },
+    /// Worksheet 7's deliverable: the global map shown directly with the box kernel, with
+    /// Silverman's kernel, and with the topological test; errors against a path-traced
+    /// reference; a Markdown summary beside the images.
+    Worksheet {
+        #[arg(long, default_value = "scenes/cornell-spheres/analytic.toml")]
+        scene: PathBuf,
+        /// Photon paths (each stores about 2.3 global photons in the Cornell box).
+        #[arg(long, default_value_t = 200_000)]
+        photons: u64,
+        #[arg(long, default_value_t = 1000)]
+        k: usize,
+        /// Topological test tolerance.
+        #[arg(long, default_value_t = 0.1)]
+        topo: f32,
+        #[arg(long, default_value_t = 1024)]
+        reference_spp: u32,
+        #[arg(long, default_value = "out/worksheet")]
+        out: PathBuf,
+        #[arg(long, default_value = "out/cache")]
+        cache: PathBuf,
+        #[arg(long)]
+        threads: Option<usize>,
     },
     /// Trace the photon sets a scene needs into the cache (or reuse them).
     Trace {
@@ -299,6 +323,25 @@ fn run(cmd: Cmd) -> Result<(), String> {
         } => bench::photons(&scene, photons, runs),
         Cmd::BenchStore { photons, dir } => bench::store(photons, &dir),
         Cmd::BenchKnn { photons, queries } => bench::knn(photons, queries),
+        Cmd::Worksheet {
+            scene,
+            photons,
+            k,
+            topo,
+            reference_spp,
+            out,
+            cache,
+            threads,
+        } => worksheet::run(&worksheet::WorksheetArgs {
+            scene,
+            photons,
+            k,
+            topo,
+            reference_spp,
+            out,
+            cache,
+            threads,
+        }),
         Cmd::Trace {
             scene,
             photons,
