@@ -46,7 +46,7 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
         [] | ["help" | "-h" | "--help", ..] => Ok(Cmd::Help),
         ["gen-scenes"] => Ok(Cmd::GenScenes),
         [
-            cmd @ ("info" | "render" | "compare" | "trace" | "estimate"),
+            cmd @ ("info" | "render" | "compare" | "trace" | "estimate" | "worksheet"),
             rest @ ..,
         ] => Ok(Cmd::Photonflow(
             std::iter::once(*cmd)
