@@ -510,3 +510,14 @@ fn image_add_scale_and_composite() {
     ));
     assert!(matches!(a.add(&small), Err(FilmError::SizeMismatch { .. })));
 }
+
+#[test]
+fn box_downsampling_averages_blocks() {
+    let img = Image::from_fn(5, 4, |x, y| [x as f32, y as f32, (x + 10 * y) as f32]);
+    let d = img.box_downsample(2);
+    assert_eq!((d.width, d.height), (2, 2));
+    // Block (1, 1) covers x in 2..4, y in 2..4: means 2.5, 2.5, 27.5.
+    assert_eq!(d.get(1, 1), [2.5, 2.5, 27.5]);
+    assert_eq!(d.get(0, 0), [0.5, 0.5, 5.5]);
+    assert_eq!(img.box_downsample(1).data, img.data);
+}
