@@ -294,7 +294,11 @@ const T_SHIFT: f32 = 2e-4;
 /// `t_max` of the caller's ray.
 #[inline]
 fn to_obvhs(ray: &Ray, t_max: f32) -> (obvhs::ray::Ray, obvhs::ray::Ray) {
-    let real = obvhs::ray::Ray::new(ray.o.into(), ray.d.into(), 0.0, t_max);
+    // `+ 0.0` turns -0.0 into +0.0: obvhs picks a ray's octant with `d < 0.0` (false for
+    // -0.0) but inverts it with a sign-keeping `safe_inverse` (-1/eps for -0.0); the two
+    // disagree and the CwBvh node test then misses everything. `-Vec3::Y` is such a ray.
+    let d = ray.d + Vec3::ZERO;
+    let real = obvhs::ray::Ray::new(ray.o.into(), d.into(), 0.0, t_max);
     let shifted = obvhs::ray::Ray {
         origin: real.origin - T_SHIFT * real.direction,
         tmax: t_max + T_SHIFT,

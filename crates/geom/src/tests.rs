@@ -483,3 +483,30 @@ fn hits_closer_than_the_bvh_node_epsilon_are_found() {
         }
     }
 }
+
+#[test]
+fn directions_with_negative_zero_components_hit() {
+    // Regression: -Vec3::Y is (-0, -1, -0); obvhs chose the octant and the inverse direction
+    // with different signs for -0.0 and the CwBvh missed the floor.
+    for kind in [BvhKind::CwBvh, BvhKind::Bvh2] {
+        let floor = quad(
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(-1.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, -1.0),
+        );
+        let geo = Geometry::with_bvh(mesh_of(&[floor]), vec![], kind);
+        for d in [
+            -Vec3::Y,
+            Vec3::new(-0.0, -1.0, 0.0),
+            Vec3::new(0.0, -1.0, -0.0),
+        ] {
+            let hit = geo.intersect(&Ray::new(Vec3::new(0.2, 1.0, 0.3), d));
+            assert_eq!(hit.map(|h| h.t), Some(1.0), "{kind:?} {d:?}");
+            assert!(geo.occluded(&Ray {
+                t_max: 2.0,
+                ..Ray::new(Vec3::new(0.2, 1.0, 0.3), d)
+            }));
+        }
+    }
+}

@@ -30,6 +30,8 @@ pub struct EstimateArgs {
     pub reference: Option<PathBuf>,
     pub exposure: f32,
     pub label: Option<String>,
+    /// Correct global-map estimates for boundary bias (kernel mass on the surface).
+    pub boundary: bool,
 }
 
 pub fn parse_kernel(s: &str) -> Result<Kernel, String> {
@@ -128,26 +130,90 @@ pub fn params(scene: &Scene, a: &EstimateArgs) -> Result<(EstimateParams, Estima
 }
 
 /// The photon maps behind [`eye::Irradiance`], with a per-thread neighbour buffer.
-struct Maps {
+struct Maps<'a> {
     global: Option<PhotonMap>,
     caustic: Option<PhotonMap>,
     gp: EstimateParams,
     cp: EstimateParams,
+    /// Boundary-bias correction of global-map estimates (see [`kernel_mass_on_surface`]).
+    boundary: Option<&'a Scene>,
 }
 
 thread_local! {
     static SCRATCH: RefCell<Vec<Neighbor>> = const { RefCell::new(Vec::new()) };
 }
 
-impl Irradiance for Maps {
+impl Irradiance for Maps<'_> {
     fn irradiance(&self, map: MapLookup, p: Vec3, n: Vec3) -> Vec3 {
         let (m, params) = match map {
             MapLookup::Global => (&self.global, &self.gp),
             MapLookup::Caustic => (&self.caustic, &self.cp),
         };
         let Some(m) = m else { return Vec3::ZERO };
-        SCRATCH.with_borrow_mut(|s| m.irradiance(p, n, params, s))
+        SCRATCH.with_borrow_mut(|s| {
+            m.knn(p, params.k, params.r_max, s);
+            let e = m.irradiance_from_neighbors(p, n, params, s);
+            match (map, self.boundary, s.last()) {
+                (MapLookup::Global, Some(scene), Some(last)) => {
+                    // The radius the estimate used (see `irradiance_from_neighbors`).
+                    let r = if s.len() == params.k || !params.r_max.is_finite() {
+                        last.d2.sqrt()
+                    } else {
+                        params.r_max
+                    };
+                    e / kernel_mass_on_surface(scene, p, n, r, params.kernel).max(MIN_MASS)
+                }
+                _ => e,
+            }
+        })
     }
+}
+
+/// Kernel mass below which the boundary correction stops growing (a point in a corner of
+/// three walls keeps about a quarter of its disc): bounds the gain, so noise cannot blow up.
+const MIN_MASS: f32 = 0.2;
+
+/// Fraction of the kernel's mass whose support lies on the surface through `x` (normal `n`):
+/// the estimate divides by pi r^2 as if the whole disc of radius `r` were surface, so
+/// dividing by this fraction removes boundary bias ("cut and normalise"; algorithms.md §2.5
+/// remedy 1; the ray-cast support test follows Tobler & Maierhofer 2006). Quadrature: 4
+/// equal-area rings x 8 angles; a point counts as surface if a short probe ray from just
+/// above it along `-n` meets a surface parallel to this one within twice that height.
+pub(crate) fn kernel_mass_on_surface(
+    scene: &Scene,
+    x: Vec3,
+    n: Vec3,
+    r: f32,
+    kernel: Kernel,
+) -> f32 {
+    if !(r > 0.0 && r.is_finite()) {
+        return 1.0;
+    }
+    let frame = math::Frame::from_z(n);
+    let h = 0.01 * r;
+    let (mut on, mut all) = (0.0f64, 0.0f64);
+    for ring in 0..4 {
+        let t = ((ring as f32 + 0.5) / 4.0).sqrt();
+        let w = kernel.weight(t as f64);
+        for a in 0..8 {
+            // Offsets keep points off the axes, where walls of an axis-aligned box would cut
+            // through them.
+            let phi = std::f32::consts::TAU * (a as f32 + 0.25 + 0.5 * (ring % 2) as f32) / 8.0;
+            let q = x + frame.to_world(Vec3::new(t * r * phi.cos(), t * r * phi.sin(), 0.0));
+            let probe = geom::Ray {
+                o: q + h * n,
+                d: -n,
+                t_max: 2.0 * h,
+            };
+            all += w;
+            if let Some(hit) = scene.geometry.intersect(&probe)
+                && hit.point.n.dot(n).abs() > 0.99
+            {
+                on += w;
+            }
+        }
+    }
+    if all > 0.0 { (on / all) as f32 } else { 1.0 }
 }
 
 fn load_map(path: &Path, key: &CacheKey, kind: MapKind) -> Result<PhotonMap, String> {
@@ -201,6 +267,7 @@ pub fn estimate(scene: &Scene, a: &EstimateArgs) -> Result<EstimateOutput, Strin
         caustic,
         gp,
         cp,
+        boundary: a.boundary.then_some(scene),
     };
     let spp = a.spp.unwrap_or(1);
     if spp == 0 || spp > 1 << 20 {
@@ -260,6 +327,7 @@ pub fn estimate(scene: &Scene, a: &EstimateArgs) -> Result<EstimateOutput, Strin
         "global_estimate": maps.gp,
         "caustic_estimate": maps.cp,
         "kernel": kernel_name(maps.gp.kernel),
+        "boundary_correction": a.boundary,
         "time_load_and_index_s": t_load,
         "time_render_s": t_render,
         "time_total_s": seconds,

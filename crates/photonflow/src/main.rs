@@ -175,6 +175,10 @@ struct PhotonArgs {
     /// Drop the k-th photon (Garcia et al. 2012).
     #[arg(long)]
     drop_kth: bool,
+    /// Correct global-map estimates for boundary bias: divide by the share of the kernel's
+    /// mass that lies on the surface (found by short probe rays).
+    #[arg(long)]
+    boundary: bool,
     /// Final-gather rays per sample.
     #[arg(long, default_value_t = 16)]
     gather_rays: u32,
@@ -219,6 +223,7 @@ fn estimate_args(
         reference: p.reference,
         exposure,
         label: p.label,
+        boundary: p.boundary,
     }
 }
 

@@ -146,3 +146,27 @@ fn the_cache_reuses_only_identical_runs() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn kernel_mass_on_surface_is_one_inside_and_drops_at_edges_and_corners() {
+    use crate::estimate::kernel_mass_on_surface;
+    use density::Kernel;
+    use glam::Vec3;
+    let s = cornell();
+    // Floor centre, away from the spheres' footprints: the whole disc is floor.
+    let centre = Vec3::new(-7.0, 0.0, -2.0);
+    let m = kernel_mass_on_surface(&s, centre, Vec3::Y, 0.5, Kernel::Uniform);
+    assert_eq!(m, 1.0);
+    // At the back wall (z = -13.98), the floor disc is cut in half.
+    let edge = Vec3::new(-7.0, 0.0, -13.98);
+    let m = kernel_mass_on_surface(&s, edge, Vec3::Y, 0.5, Kernel::Uniform);
+    assert!((m - 0.5).abs() < 0.07, "{m}");
+    // In the floor's corner with the right wall (x = 0): a quarter.
+    let corner = Vec3::new(0.0, 0.0, -13.98);
+    let m = kernel_mass_on_surface(&s, corner, Vec3::Y, 0.5, Kernel::Uniform);
+    assert!((m - 0.25).abs() < 0.07, "{m}");
+    // Past the open front (z = 0) the floor ends too.
+    let front = Vec3::new(-7.0, 0.0, 0.0);
+    let m = kernel_mass_on_surface(&s, front, Vec3::Y, 0.5, Kernel::Silverman);
+    assert!((m - 0.5).abs() < 0.07, "{m}");
+}
