@@ -23,7 +23,7 @@ mod index;
 mod kernel;
 
 pub use estimate::{EstimateParams, PhotonMap, radiance_lambertian};
-pub use index::{Brute, Index, IndexKind, KdTree, Kiddo, Neighbor};
+pub use index::{Brute, Index, IndexKind, KdTree, Kiddo, KnnHint, Neighbor};
 pub use kernel::{JENSEN_ALPHA, JENSEN_BETA, Kernel, jensen_gaussian_mass};
 
 #[cfg(test)]
