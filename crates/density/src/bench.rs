@@ -84,3 +84,110 @@ pub fn bench_knn(photons: usize, ks: &[usize], queries: usize, seed: u64) -> Vec
     }
     out
 }
+
+/// One row of [`bench_coherent`]: queries/s of the plain k-NN search and of the hinted
+/// (radius-first) one, and of the irradiance estimate built on each.
+#[derive(Clone, Copy, Debug)]
+pub struct CoherentBench {
+    pub k: usize,
+    /// Pixel order (true) or the same points shuffled (false).
+    pub coherent: bool,
+    pub queries: usize,
+    pub knn_per_s: f64,
+    pub hinted_per_s: f64,
+    pub irradiance_per_s: f64,
+    pub irradiance_hinted_per_s: f64,
+}
+
+/// One timed query: point, normal, hint, neighbour buffer; returns something to keep.
+type Probe<'a> = dyn FnMut(Vec3, Vec3, &mut crate::KnnHint, &mut Vec<Neighbor>) -> f32 + 'a;
+
+/// The global map shown directly: `photons` on the unit cube's faces travelling inwards,
+/// one estimate per pixel of a `res`² camera looking into the box through its z = 0 face
+/// (back wall, floor, ceiling, side walls, their edges), visited row by row with one
+/// [`crate::KnnHint`] carried from pixel to pixel; then the same points in random order.
+/// Single-threaded; median of `RUNS` passes; the kd-tree.
+pub fn bench_coherent(photons: usize, ks: &[usize], res: usize, seed: u64) -> Vec<CoherentBench> {
+    use crate::{EstimateParams, KnnHint, PhotonMap};
+    let mut rng = Rng::for_index(seed, 0);
+    let photons: Vec<store::Photon> = (0..photons)
+        .map(|i| {
+            let p = Vec3::from(point_on_unit_cube(&mut rng));
+            // Inwards: towards the face's side of the centre.
+            let c = p - 0.5;
+            let a = c.abs().max_position();
+            let mut dir = Vec3::ZERO;
+            dir[a] = c[a].signum();
+            store::Photon::new(p, Vec3::ONE, dir, i as u32)
+        })
+        .collect();
+    let map = PhotonMap::build(photons, 1, IndexKind::KdTree);
+    let eye = Vec3::new(0.5, 0.5, -1.2);
+    let pixels: Vec<(Vec3, Vec3)> = (0..res * res)
+        .map(|i| {
+            let (px, py) = ((i % res) as f32 + 0.5, (i / res) as f32 + 0.5);
+            let d = Vec3::new(px / res as f32, 1.0 - py / res as f32, 0.0) - eye;
+            // Exit point of the ray from the box [0,1]³ and the inward normal there.
+            let t_exit = |a: usize| {
+                let side = if d[a] > 0.0 { 1.0 } else { 0.0 };
+                (side - eye[a]) / d[a]
+            };
+            let a = (0..3)
+                .min_by(|&a, &b| t_exit(a).total_cmp(&t_exit(b)))
+                .unwrap_or(2);
+            let mut n = Vec3::ZERO;
+            n[a] = -d[a].signum();
+            (eye + d * t_exit(a), n)
+        })
+        .collect();
+    let mut shuffled = pixels.clone();
+    for i in (1..shuffled.len()).rev() {
+        shuffled.swap(i, rng.below(i as u32 + 1) as usize);
+    }
+    let median = |f: &mut dyn FnMut() -> f64| {
+        let mut t: Vec<f64> = (0..RUNS).map(|_| f()).collect();
+        t.sort_by(f64::total_cmp);
+        t[RUNS / 2].max(1e-12)
+    };
+    let mut out = Vec::new();
+    for &k in ks {
+        let p = EstimateParams {
+            k,
+            ..Default::default()
+        };
+        for (coherent, qs) in [(true, &pixels), (false, &shuffled)] {
+            let mut s: Vec<Neighbor> = Vec::with_capacity(4 * k);
+            let mut time = |f: &mut Probe| {
+                qs.len() as f64
+                    / median(&mut || {
+                        let mut hint = KnnHint::NONE;
+                        let t = Instant::now();
+                        let mut acc = 0.0;
+                        for &(x, n) in qs.iter() {
+                            acc += f(x, n, &mut hint, &mut s);
+                        }
+                        black_box(acc);
+                        t.elapsed().as_secs_f64()
+                    })
+            };
+            out.push(CoherentBench {
+                k,
+                coherent,
+                queries: qs.len(),
+                knn_per_s: time(&mut |x, _, _, s| {
+                    map.knn(x, k, f32::INFINITY, s);
+                    s.len() as f32
+                }),
+                hinted_per_s: time(&mut |x, _, h, s| {
+                    map.knn_hinted(x, k, f32::INFINITY, h, s);
+                    s.len() as f32
+                }),
+                irradiance_per_s: time(&mut |x, n, _, s| map.irradiance(x, n, &p, s).x),
+                irradiance_hinted_per_s: time(&mut |x, n, h, s| {
+                    map.irradiance_hinted(x, n, &p, h, s).x
+                }),
+            });
+        }
+    }
+    out
+}

@@ -1,5 +1,5 @@
 use super::*;
-use crate::{EstimateParams, Kernel, PhotonMap, radiance_lambertian};
+use crate::{EstimateParams, Kernel, KnnHint, PhotonMap, radiance_lambertian};
 use glam::Vec3;
 use math::Rng;
 use std::f64::consts::PI;
@@ -222,7 +222,8 @@ each_index!(
             ..p
         };
         let e = map.irradiance(Vec3::ZERO, Vec3::Y, &p, &mut s);
-        let r2 = s[9].d2 as f64;
+        // `irradiance` leaves them in index order: the farthest is the largest d2.
+        let r2 = s.iter().fold(0f32, |m, n| m.max(n.d2)) as f64;
         assert!(
             (e.x as f64 - 10.0 / (PI * r2) / 4.0).abs() < 1e-5 * e.x as f64,
             "{e}"
@@ -393,3 +394,80 @@ fn lambertian_radiance_is_albedo_over_pi_times_irradiance() {
     let want = Vec3::new(1.8, 2.0, 0.0) / std::f32::consts::PI;
     assert!((l - want).abs().max_element() < 1e-6, "{l}");
 }
+
+// `irradiance_hinted` is `irradiance` bit for bit, whatever the hint, for every estimator
+// option: photons on a cube's faces (edges, corners) with a dense clump, queries walking
+// in small steps with jumps, each under hints carried, absent, useless, small and large.
+each_index!(hinted_irradiance_is_bit_identical, |kind: IndexKind| {
+    let mut rng = Rng::new(21);
+    let mut photons: Vec<Photon> = (0..8000)
+        .map(|i| {
+            let p = Vec3::from(crate::bench::point_on_unit_cube(&mut rng));
+            let dir = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5;
+            Photon::new(p, Vec3::new(1.0, 0.5, 0.25) * (1.0 + rng.uniform()), dir, i)
+        })
+        .collect();
+    photons.extend((0..200).map(|i| {
+        let p = Vec3::new(0.5, 1e-4 * (i % 5) as f32, 0.5);
+        Photon::new(p, Vec3::ONE, -Vec3::Y, 0)
+    }));
+    let map = PhotonMap::build(photons, 3, kind);
+    let mut s = Vec::new();
+    let mut plain = Vec::new();
+    let params: Vec<EstimateParams> = [1, 50, 250]
+        .into_iter()
+        .flat_map(|k| {
+            [
+                (f32::INFINITY, Kernel::Uniform, false, None, true),
+                (f32::INFINITY, Kernel::Silverman, true, None, true),
+                (0.06, Kernel::Uniform, true, Some(0.1), true),
+                (0.06, Kernel::Cone { k: 1.0 }, false, Some(0.1), false),
+                (f32::INFINITY, Kernel::Gaussian, true, Some(0.2), false),
+            ]
+            .map(
+                |(r_max, kernel, drop_kth, topo, same_side)| EstimateParams {
+                    k,
+                    r_max,
+                    kernel,
+                    drop_kth,
+                    topo,
+                    same_side,
+                },
+            )
+        })
+        .collect();
+    let mut carried = vec![KnnHint::NONE; params.len()];
+    let mut x = Vec3::new(0.2, 0.0, 0.2);
+    for i in 0..120 {
+        x = match i % 12 {
+            0 => Vec3::from(crate::bench::point_on_unit_cube(&mut rng)),
+            1 => Vec3::new(0.5, 0.0, 0.5),
+            2 => Vec3::new(0.0, 0.0, 0.3),
+            _ => (x + Vec3::new(rng.uniform(), 0.0, rng.uniform()) * 0.004).min(Vec3::ONE),
+        };
+        for (p, carried) in params.iter().zip(&mut carried) {
+            let want = map.irradiance(x, Vec3::Y, p, &mut plain);
+            let mut hints = [
+                *carried,
+                KnnHint::NONE,
+                KnnHint::new(x, 0.0),
+                KnnHint::new(x, f32::NAN),
+                KnnHint::new(x, f32::INFINITY),
+                KnnHint::new(x, 1e-3),
+                KnnHint::new(x, 0.5),
+            ];
+            for (j, hint) in hints.iter_mut().enumerate() {
+                let e = map.irradiance_hinted(x, Vec3::Y, p, hint, &mut s);
+                let what = format!("{} x={x} {p:?} hint #{j}", kind.name());
+                assert_eq!(s, plain, "{what}");
+                assert_eq!(
+                    e.to_array().map(f32::to_bits),
+                    want.to_array().map(f32::to_bits),
+                    "{what}"
+                );
+            }
+            *carried = hints[0];
+            assert!(want.is_finite());
+        }
+    }
+});

@@ -1,6 +1,6 @@
 use super::*;
 use crate::index::dist2;
-use crate::{Index, Neighbor, PhotonMap};
+use crate::{Index, KnnHint, Neighbor, PhotonMap};
 use glam::Vec3;
 use math::Rng;
 use store::Photon;
@@ -150,3 +150,129 @@ each_index!(
         }
     }
 );
+
+/// Radius guesses for `knn_hinted`: none, useless, too small, about right, too large.
+fn hints(at: Vec3, r: f32) -> [KnnHint; 10] {
+    [
+        KnnHint::NONE,
+        KnnHint::new(at, 0.0),
+        KnnHint::new(at, f32::NAN),
+        KnnHint::new(at, f32::INFINITY),
+        KnnHint::new(at, -1.0),
+        KnnHint::new(at, 1e-30),
+        KnnHint::new(at, r * 0.5),
+        KnnHint::new(at, r),
+        KnnHint::new(at, r * 30.0),
+        KnnHint::new(Vec3::NAN, r),
+    ]
+}
+
+/// `knn_hinted` finds exactly `knn`'s set, in the same order whatever the hint, and
+/// leaves the k-th distance (or r_max) in the hint.
+fn check_hinted(
+    index: &Index,
+    q: Vec3,
+    k: usize,
+    r_max: f32,
+    carried: &mut KnnHint,
+    out: &mut Vec<Neighbor>,
+) {
+    let mut want = Vec::new();
+    index.knn(q, k, r_max, &mut want);
+    let r = want.last().map_or(0.1, |n| n.d2.sqrt());
+    let mut first: Option<Vec<Neighbor>> = None;
+    for (i, mut hint) in hints(q + Vec3::splat(0.01), r)
+        .into_iter()
+        .chain([*carried])
+        .enumerate()
+    {
+        index.knn_hinted(q, k, r_max, &mut hint, out);
+        let what = format!(
+            "{} q={q} k={k} r_max={r_max} hint #{i}",
+            index.kind().name()
+        );
+        let mut sorted = out.clone();
+        sorted.sort_by_key(|n| (n.d2.to_bits(), n.index));
+        assert_eq!(sorted, want, "{what}");
+        match &first {
+            None => first = Some(out.clone()),
+            Some(f) => assert_eq!(out, f, "{what}: order depends on the hint"),
+        }
+        if !want.is_empty() && q.is_finite() {
+            let expect = if want.len() == k { r } else { r_max };
+            assert_eq!(hint.r.to_bits(), expect.to_bits(), "{what}");
+        }
+    }
+    index.knn_hinted(q, k, r_max, carried, out);
+}
+
+each_index!(
+    hinted_equals_plain_for_every_n_up_to_64,
+    |kind: IndexKind| {
+        let mut out = Vec::new();
+        for n in 0..=64usize {
+            let mut rng = Rng::for_index(17, n as u64);
+            for (points, lo, step, radius) in [
+                (grid_points(n, &mut rng), -0.5f32, 1.3f32, 1.5f32),
+                (random_points(n, &mut rng), -0.25, 0.5, 0.4),
+            ] {
+                let index = Index::build(kind, &points);
+                let mut carried = KnnHint::NONE;
+                for i in 0..64 {
+                    let q = Vec3::new(
+                        lo + step * (i % 4) as f32,
+                        lo + step * (i / 4 % 4) as f32,
+                        lo + step * (i / 16) as f32,
+                    );
+                    for k in [0, 1, 2, 5, n, n + 3] {
+                        for r_max in [f32::INFINITY, radius, 0.0] {
+                            check_hinted(&index, q, k, r_max, &mut carried, &mut out);
+                        }
+                    }
+                }
+            }
+        }
+    }
+);
+
+each_index!(hinted_equals_plain_on_10k_photons, |kind: IndexKind| {
+    let mut rng = Rng::new(12);
+    let mut points: Vec<[f32; 3]> = (0..10_000)
+        .map(|_| crate::bench::point_on_unit_cube(&mut rng))
+        .collect();
+    points.extend_from_within(0..50);
+    points.extend((0..300).map(|i| [0.5, 0.5, 1e-4 * (i % 7) as f32]));
+    let index = Index::build(kind, &points);
+    let mut out = Vec::new();
+    let mut carried = KnnHint::NONE;
+    // A walk of small steps (the coherent case the hint is for), jumps, and the clump.
+    let mut q = Vec3::new(0.3, 0.0, 0.3);
+    for i in 0..150 {
+        q = match i % 10 {
+            0 => Vec3::from(crate::bench::point_on_unit_cube(&mut rng)),
+            1 => Vec3::new(0.5, 0.5, 0.0),
+            2 => Vec3::NAN,
+            3 => Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 1.2 - 0.1,
+            _ => q + Vec3::new(rng.uniform(), 0.0, rng.uniform()) * 0.01,
+        };
+        for k in [1, 10, 250, 1000] {
+            for r_max in [f32::INFINITY, 0.05] {
+                check_hinted(&index, q, k, r_max, &mut carried, &mut out);
+            }
+        }
+    }
+});
+
+each_index!(hinted_duplicates_all_at_one_point, |kind: IndexKind| {
+    let points = vec![[0.25f32, -1.0, 3.0]; 1000];
+    let index = Index::build(kind, &points);
+    let mut out = Vec::new();
+    let mut carried = KnnHint::NONE;
+    for q in [Vec3::new(0.25, -1.0, 3.0), Vec3::ZERO, Vec3::splat(1e6)] {
+        for k in [1, 10, 999, 1000, 1500] {
+            for r_max in [f32::INFINITY, 0.5, 0.0] {
+                check_hinted(&index, q, k, r_max, &mut carried, &mut out);
+            }
+        }
+    }
+});
