@@ -4,7 +4,7 @@
 
 use crate::pipeline::{self, CacheKey};
 use crate::progress::Progress;
-use density::{EstimateParams, IndexKind, Kernel, Neighbor, PhotonMap};
+use density::{EstimateParams, IndexKind, Kernel, KnnHint, Neighbor, PhotonMap};
 use eye::{Irradiance, MapLookup, PhotonMethod, RenderOptions};
 use film::{Image, Normalize};
 use glam::Vec3;
@@ -139,8 +139,18 @@ struct Maps<'a> {
     boundary: Option<&'a Scene>,
 }
 
+/// Per-thread query state: the neighbour buffer, and one k-NN hint per map. A tile is
+/// rendered row by row on one thread, so consecutive queries are neighbours and the previous
+/// query's radius seeds the next search (exact either way; density's `knn_hinted`).
+struct QueryState {
+    scratch: Vec<Neighbor>,
+    hints: [KnnHint; 2],
+}
+
 thread_local! {
-    static SCRATCH: RefCell<Vec<Neighbor>> = const { RefCell::new(Vec::new()) };
+    static STATE: RefCell<QueryState> = const {
+        RefCell::new(QueryState { scratch: Vec::new(), hints: [KnnHint::NONE; 2] })
+    };
 }
 
 impl Irradiance for Maps<'_> {
@@ -150,18 +160,14 @@ impl Irradiance for Maps<'_> {
             MapLookup::Caustic => (&self.caustic, &self.cp),
         };
         let Some(m) = m else { return Vec3::ZERO };
-        SCRATCH.with_borrow_mut(|s| {
-            m.knn(p, params.k, params.r_max, s);
-            let e = m.irradiance_from_neighbors(p, n, params, s);
-            match (map, self.boundary, s.last()) {
-                (MapLookup::Global, Some(scene), Some(last)) => {
-                    // The radius the estimate used (see `irradiance_from_neighbors`).
-                    let r = if s.len() == params.k || !params.r_max.is_finite() {
-                        last.d2.sqrt()
-                    } else {
-                        params.r_max
-                    };
-                    e / kernel_mass_on_surface(scene, p, n, r, params.kernel).max(MIN_MASS)
+        STATE.with_borrow_mut(|st| {
+            let hint = &mut st.hints[(map == MapLookup::Caustic) as usize];
+            let e = m.irradiance_hinted(p, n, params, hint, &mut st.scratch);
+            match (map, self.boundary) {
+                // The hint now holds the radius the estimate used.
+                (MapLookup::Global, Some(scene)) if !st.scratch.is_empty() => {
+                    let mass = kernel_mass_on_surface(scene, p, n, hint.r, params.kernel);
+                    e / mass.max(MIN_MASS)
                 }
                 _ => e,
             }
