@@ -135,17 +135,7 @@ impl Geometry {
 
     /// Closest hit with `0 < t < ray.t_max`.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        let mut best_t = ray.t_max;
-        let mut best: Option<Prim> = None;
-        for (i, s) in self.spheres.iter().enumerate() {
-            if let Some(t) = s.intersect(&Ray {
-                t_max: best_t,
-                ..*ray
-            }) {
-                best_t = t;
-                best = Some(Prim::Sphere(i as u32));
-            }
-        }
+        let (mut best_t, mut best) = self.closest_sphere(ray);
         let (shifted, real) = to_obvhs(ray, best_t);
         let mut hit = RayHit::none();
         let rt = &self.rt;
@@ -198,17 +188,7 @@ impl Geometry {
 
     /// Closest hit by testing every primitive: the reference the BVH is tested against.
     pub fn intersect_brute_force(&self, ray: &Ray) -> Option<Hit> {
-        let mut best_t = ray.t_max;
-        let mut best = None;
-        for (i, s) in self.spheres.iter().enumerate() {
-            if let Some(t) = s.intersect(&Ray {
-                t_max: best_t,
-                ..*ray
-            }) {
-                best_t = t;
-                best = Some(Prim::Sphere(i as u32));
-            }
-        }
+        let (mut best_t, mut best) = self.closest_sphere(ray);
         let (_, real) = to_obvhs(ray, best_t);
         for (slot, tri) in self.rt.iter().enumerate() {
             let t = intersect_triangle(
@@ -227,6 +207,23 @@ impl Geometry {
             Prim::Sphere(i) => Some(self.sphere_hit(ray, i, best_t)),
             Prim::Triangle(slot) => Some(self.triangle_hit(ray, slot as usize, best_t)),
         }
+    }
+
+    /// The nearest sphere hit below `ray.t_max` (spheres are few: tested one by one).
+    fn closest_sphere(&self, ray: &Ray) -> (f32, Option<Prim>) {
+        let mut best_t = ray.t_max;
+        let mut best = None;
+        for (i, s) in self.spheres.iter().enumerate() {
+            let r = Ray {
+                t_max: best_t,
+                ..*ray
+            };
+            if let Some(t) = s.intersect(&r) {
+                best_t = t;
+                best = Some(Prim::Sphere(i as u32));
+            }
+        }
+        (best_t, best)
     }
 
     fn sphere_hit(&self, ray: &Ray, i: u32, t: f32) -> Hit {

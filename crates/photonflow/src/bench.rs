@@ -210,5 +210,21 @@ pub fn knn(photons: usize, queries: usize) -> Result<(), String> {
             r.build_s
         );
     }
+    let res = 128;
+    println!(
+        "kd-tree, the global map shown directly: {res}x{res} pixel-order queries (hint carried \
+         from pixel to pixel) and the same points shuffled"
+    );
+    for r in density::bench::bench_coherent(photons, &[50, 250, 1000], res, 7) {
+        println!(
+            "{:>9} k = {:4}: k-NN {:9.0} /s, hinted {:9.0} /s; irradiance {:9.0} /s, hinted {:9.0} /s",
+            if r.coherent { "pixels" } else { "shuffled" },
+            r.k,
+            r.knn_per_s,
+            r.hinted_per_s,
+            r.irradiance_per_s,
+            r.irradiance_hinted_per_s
+        );
+    }
     Ok(())
 }
