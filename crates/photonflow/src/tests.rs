@@ -170,3 +170,41 @@ fn kernel_mass_on_surface_is_one_inside_and_drops_at_edges_and_corners() {
     let m = kernel_mass_on_surface(&s, front, Vec3::Y, 0.5, Kernel::Silverman);
     assert!((m - 0.5).abs() < 0.07, "{m}");
 }
+
+#[test]
+fn point_triangle_distance_matches_a_dense_search() {
+    use crate::worksheet::distance_for_test;
+    use glam::Vec3;
+    let mut rng = math::Rng::new(5);
+    let mut v = || Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 4.0 - 2.0;
+    for _ in 0..200 {
+        let t = [v(), v(), v()];
+        let p = v();
+        // Brute force over a 200 x 200 barycentric grid: an upper bound within the grid's
+        // spacing of the true distance.
+        let n = 200;
+        let mut best = f32::INFINITY;
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let (b1, b2) = (i as f32 / n as f32, j as f32 / n as f32);
+                let q = t[0] + (t[1] - t[0]) * b1 + (t[2] - t[0]) * b2;
+                best = best.min((p - q).length());
+            }
+        }
+        let d = distance_for_test(p, t);
+        let spacing = ((t[1] - t[0]).length() + (t[2] - t[0]).length()) / n as f32;
+        assert!(d <= best + 1e-5 && d >= best - spacing, "{d} vs {best}");
+    }
+}
+
+#[test]
+fn the_edge_mask_marks_the_inner_edges_only() {
+    let s = cornell();
+    let m = crate::worksheet::edge_mask(&s, 0.4);
+    let share = m.count() as f64 / m.pixels.len() as f64;
+    // A band of 0.4 along the box's inner edges covers a modest share of the image.
+    assert!(share > 0.03 && share < 0.3, "{share}");
+    // The centre of the back wall is far from every edge.
+    let (w, h) = (m.width, m.height);
+    assert!(!m.pixels[(h / 2 - 40) * w + w / 2]);
+}
