@@ -2,6 +2,7 @@
 //! set is an error that says to run `trace` first, so swapping the estimator costs only the
 //! estimate (issue 5: "swap the estimator stage alone").
 
+use crate::cache::IrradianceCache;
 use crate::pipeline::{self, CacheKey};
 use crate::progress::Progress;
 use density::{EstimateParams, IndexKind, Kernel, KnnHint, Neighbor, PhotonMap};
@@ -32,6 +33,8 @@ pub struct EstimateArgs {
     pub label: Option<String>,
     /// Correct global-map estimates for boundary bias (kernel mass on the surface).
     pub boundary: bool,
+    /// Final gathering reads irradiance precomputed at every n-th global photon (0: off).
+    pub gather_cache: usize,
 }
 
 pub fn parse_kernel(s: &str) -> Result<Kernel, String> {
@@ -137,6 +140,8 @@ struct Maps<'a> {
     cp: EstimateParams,
     /// Boundary-bias correction of global-map estimates (see [`kernel_mass_on_surface`]).
     boundary: Option<&'a Scene>,
+    /// Precomputed global-map irradiance, answering every global lookup (final gathering).
+    gather_cache: Option<IrradianceCache>,
 }
 
 /// Per-thread query state: the neighbour buffer, and one k-NN hint per map. A tile is
@@ -160,6 +165,9 @@ impl Irradiance for Maps<'_> {
             MapLookup::Caustic => (&self.caustic, &self.cp),
         };
         let Some(m) = m else { return Vec3::ZERO };
+        if let (MapLookup::Global, Some(c)) = (map, &self.gather_cache) {
+            return c.lookup(p, n);
+        }
         STATE.with_borrow_mut(|st| {
             let hint = &mut st.hints[(map == MapLookup::Caustic) as usize];
             let e = m.irradiance_hinted(p, n, params, hint, &mut st.scratch);
@@ -268,12 +276,28 @@ pub fn estimate(scene: &Scene, a: &EstimateArgs) -> Result<EstimateOutput, Strin
     }
     let t_load = t0.elapsed().as_secs_f64();
     let (gp, cp) = params(scene, a)?;
+    let t_cache = Instant::now();
+    let gather_cache = match (a.method, &global) {
+        (PhotonMethod::FinalGather { .. }, Some(g)) if a.gather_cache > 0 => {
+            Some(IrradianceCache::build(scene, g, &gp, a.gather_cache))
+        }
+        _ => None,
+    };
+    let t_cache = t_cache.elapsed().as_secs_f64();
+    if let Some(c) = &gather_cache {
+        println!(
+            "irradiance cache: {} points (every {}th global photon) in {t_cache:.2} s",
+            c.len(),
+            a.gather_cache
+        );
+    }
     let maps = Maps {
         global,
         caustic,
         gp,
         cp,
         boundary: a.boundary.then_some(scene),
+        gather_cache,
     };
     let spp = a.spp.unwrap_or(1);
     if spp == 0 || spp > 1 << 20 {
@@ -334,6 +358,8 @@ pub fn estimate(scene: &Scene, a: &EstimateArgs) -> Result<EstimateOutput, Strin
         "caustic_estimate": maps.cp,
         "kernel": kernel_name(maps.gp.kernel),
         "boundary_correction": a.boundary,
+        "gather_cache_stride": maps.gather_cache.as_ref().map(|_| a.gather_cache),
+        "time_gather_cache_s": t_cache,
         "time_load_and_index_s": t_load,
         "time_render_s": t_render,
         "time_total_s": seconds,

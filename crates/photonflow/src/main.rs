@@ -3,6 +3,7 @@
 //! nothing here panics on bad input.
 
 mod bench;
+mod cache;
 mod estimate;
 mod pipeline;
 mod progress;
@@ -65,11 +66,13 @@ enum Cmd {
         queries: usize,
     },
     /// Render an image. `--method path` is the path-traced reference; `global-direct` and
-    /// `final-gather` chain trace (or reuse the cached photons) and estimate.
+    /// `final-gather` chain trace (or reuse the cached photons) → estimate → composite.
     Render {
         scene: PathBuf,
-        #[arg(long, default_value = "path")]
-        method: String,
+        /// path, global-direct or final-gather (default: the scene's render.method, whose
+        /// default is final-gather).
+        #[arg(long)]
+        method: Option<String>,
         #[command(flatten)]
         photon: PhotonArgs,
         /// Samples per pixel (default: the scene file's render.spp).
@@ -91,9 +94,10 @@ enum Cmd {
     /// Estimate an image from cached photon sets (never traces).
     Estimate {
         scene: PathBuf,
-        /// global-direct (the global map shown directly) or final-gather.
-        #[arg(long, default_value = "global-direct")]
-        method: String,
+        /// global-direct (the global map shown directly) or final-gather (default: the
+        /// scene's render.method when it is one of these, else global-direct).
+        #[arg(long)]
+        method: Option<String>,
         #[command(flatten)]
         photon: PhotonArgs,
         #[arg(long)]
@@ -179,15 +183,26 @@ struct PhotonArgs {
     /// mass that lies on the surface (found by short probe rays).
     #[arg(long)]
     boundary: bool,
-    /// Final-gather rays per sample.
-    #[arg(long, default_value_t = 16)]
-    gather_rays: u32,
+    /// Final-gather rays per sample (default: the scene's render.gather_rays, 16).
+    #[arg(long)]
+    gather_rays: Option<u32>,
+    /// Final gathering reads irradiance precomputed at every N-th global photon
+    /// (Christensen 1999); 0 estimates from the map at every gather hit.
+    #[arg(long, default_value_t = 4)]
+    gather_cache: usize,
     /// Compare with this linear EXR (the path-traced reference) and record the error.
     #[arg(long)]
     reference: Option<PathBuf>,
     /// Name of the output directory's method part.
     #[arg(long)]
     label: Option<String>,
+}
+
+/// The method a command runs: the flag, else the scene file's `render.method`.
+fn method_of(scene_path: &PathBuf, flag: Option<String>) -> Result<(String, u32), String> {
+    let s = scene::Scene::load(scene_path).map_err(|e| e.to_string())?;
+    let r = s.render();
+    Ok((flag.unwrap_or_else(|| r.method.clone()), r.gather_rays))
 }
 
 fn photon_method(name: &str, rays: u32) -> Result<eye::PhotonMethod, String> {
@@ -224,6 +239,7 @@ fn estimate_args(
         exposure,
         label: p.label,
         boundary: p.boundary,
+        gather_cache: p.gather_cache,
     }
 }
 
@@ -271,8 +287,8 @@ fn run(cmd: Cmd) -> Result<(), String> {
             threads,
             out,
             exposure,
-        } => match method.as_str() {
-            "path" => render::path(render::RenderArgs {
+        } => match method_of(&scene, method)? {
+            (m, _) if m == "path" => render::path(render::RenderArgs {
                 scene,
                 spp,
                 no_caustics,
@@ -280,9 +296,9 @@ fn run(cmd: Cmd) -> Result<(), String> {
                 out,
                 exposure,
             }),
-            m => {
-                let method =
-                    photon_method(m, photon.gather_rays).map_err(|e| format!("{e}; or `path`"))?;
+            (m, rays) => {
+                let method = photon_method(&m, photon.gather_rays.unwrap_or(rays))
+                    .map_err(|e| format!("{e}; or `path`"))?;
                 let s = scene::Scene::load(&scene).map_err(|e| e.to_string())?;
                 let t = trace::trace(
                     &s,
@@ -315,7 +331,13 @@ fn run(cmd: Cmd) -> Result<(), String> {
             out,
             exposure,
         } => {
-            let m = photon_method(&method, photon.gather_rays)?;
+            let (m, rays) = method_of(&scene, method)?;
+            let m = if m == "path" {
+                "global-direct".to_string()
+            } else {
+                m
+            };
+            let m = photon_method(&m, photon.gather_rays.unwrap_or(rays))?;
             let s = scene::Scene::load(&scene).map_err(|e| e.to_string())?;
             estimate::estimate(&s, &estimate_args(m, photon, spp, threads, out, exposure))
                 .map(|_| ())

@@ -208,3 +208,48 @@ fn the_edge_mask_marks_the_inner_edges_only() {
     let (w, h) = (m.width, m.height);
     assert!(!m.pixels[(h / 2 - 40) * w + w / 2]);
 }
+
+#[test]
+fn the_gather_cache_answers_like_the_map_it_summarises() {
+    use crate::cache::IrradianceCache;
+    use density::{EstimateParams, IndexKind, PhotonMap};
+    use glam::Vec3;
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/corner/corner.toml");
+    let scene = scene::Scene::load(p).unwrap();
+    let params = EmitParams {
+        photons: 40_000,
+        ..EmitParams::default()
+    };
+    let plan = Plan::for_scene(&scene, &params).unwrap();
+    let traced = emit::trace_range(&scene, &params, &plan, 0..params.photons);
+    let map = PhotonMap::build(traced.global, 1, IndexKind::KdTree);
+    let est = EstimateParams {
+        k: 100,
+        ..EstimateParams::default()
+    };
+    let cache = IrradianceCache::build(&scene, &map, &est, 4);
+    assert!(
+        cache.len() > map.len() / 5,
+        "{} of {}",
+        cache.len(),
+        map.len()
+    );
+    // On the floor (normal +y) away from the wall, the cached answer tracks the estimate.
+    let mut rng = math::Rng::new(3);
+    let (mut exact, mut cached) = (0.0f64, 0.0f64);
+    let mut scratch = Vec::new();
+    for _ in 0..2000 {
+        let x = Vec3::new(0.5 + 3.0 * rng.uniform(), 0.0, -1.5 + 3.0 * rng.uniform());
+        exact += map.irradiance(x, Vec3::Y, &est, &mut scratch).x as f64;
+        cached += cache.lookup(x, Vec3::Y).x as f64;
+    }
+    assert!(exact > 0.0);
+    assert!(
+        (cached / exact - 1.0).abs() < 0.02,
+        "cached {cached} vs exact {exact}"
+    );
+    // A wall point never reads a floor value: normals must agree.
+    let on_wall = cache.lookup(Vec3::new(0.0, 0.05, 0.0), Vec3::X);
+    let floor_below = cache.lookup(Vec3::new(0.05, 0.0, 0.0), Vec3::Y);
+    assert_ne!(on_wall, floor_below);
+}

@@ -171,6 +171,7 @@ pub fn run(a: &WorksheetArgs) -> Result<(), String> {
                 exposure: 0.0,
                 label: Some(v.name.to_string()),
                 boundary: v.boundary,
+                gather_cache: 0,
             },
         )?;
         let img = film::read_exr(out.join("image.exr")).map_err(|e| e.to_string())?;

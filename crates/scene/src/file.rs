@@ -83,6 +83,12 @@ pub struct RenderSettings {
     pub rr_depth: u32,
     /// Tile edge in pixels for parallel rendering (does not change the image).
     pub tile: u32,
+    /// What `render` does without `--method`: `final-gather` (the course framework's
+    /// standard: direct light + caustic map + final gathering into the global map),
+    /// `global-direct` (the global map shown directly) or `path` (the path-traced reference).
+    pub method: String,
+    /// Final-gather rays per pixel sample.
+    pub gather_rays: u32,
 }
 
 impl Default for RenderSettings {
@@ -92,6 +98,8 @@ impl Default for RenderSettings {
             max_depth: 64,
             rr_depth: 3,
             tile: 16,
+            method: "final-gather".into(),
+            gather_rays: 16,
         }
     }
 }

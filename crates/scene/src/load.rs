@@ -220,6 +220,15 @@ impl<'a> Builder<'a> {
         if r.spp == 0 || r.spp > 1 << 24 {
             return Err(self.err(format!("render.spp = {} must be in 1..=16777216", r.spp)));
         }
+        if !["final-gather", "global-direct", "path"].contains(&r.method.as_str()) {
+            return Err(self.err(format!(
+                "render.method = \"{}\" is not one of final-gather, global-direct, path",
+                r.method
+            )));
+        }
+        if r.gather_rays > 1 << 16 {
+            return Err(self.err(format!("render.gather_rays = {} is absurd", r.gather_rays)));
+        }
         if r.tile == 0 || r.tile > 4096 {
             return Err(self.err(format!("render.tile = {} must be in 1..=4096", r.tile)));
         }
