@@ -167,6 +167,8 @@ fn render_writes_exr_png_layers_and_json_identically_for_any_thread_count() {
         let o = photonflow(&[
             "render",
             "scenes/cornell-spheres/analytic.toml",
+            "--method",
+            "path",
             "--spp",
             "2",
             "--threads",
@@ -333,4 +335,45 @@ fn a_truncated_cache_file_is_traced_anew() {
         good,
         "traced again, bit for bit"
     );
+}
+
+#[test]
+fn render_without_a_method_runs_the_framework_standard_deterministically() {
+    // The scene's render.method defaults to final-gather: trace → estimate → composite.
+    let dir = Scratch::new("fg", &[]);
+    let cache = dir.0.join("cache");
+    let mut images = Vec::new();
+    for threads in ["1", "2"] {
+        let out = dir.0.join(threads);
+        let o = photonflow(&[
+            "render",
+            "scenes/corner/corner.toml",
+            "--photons",
+            "20000",
+            "--k",
+            "50",
+            "--gather-rays",
+            "4",
+            "--threads",
+            threads,
+            "--cache",
+            cache.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(
+            text.contains("final-gather-4") && text.contains("irradiance cache"),
+            "{text}"
+        );
+        for layer in ["emitted", "direct", "caustic", "indirect"] {
+            assert!(
+                out.join("layers").join(format!("{layer}.exr")).exists(),
+                "{layer}"
+            );
+        }
+        images.push(std::fs::read(out.join("image.exr")).unwrap());
+    }
+    assert_eq!(images[0], images[1], "1 and 2 threads give the same image");
 }
