@@ -348,6 +348,8 @@ pub fn estimate(scene: &Scene, a: &EstimateArgs) -> Result<EstimateOutput, Strin
     let json = serde_json::json!({
         "scene": scene.path.display().to_string(),
         "scene_hash": format!("{:016x}", scene.content_hash),
+        "image_hash": format!("{:016x}", scene.image_hash),
+        "photon_hash": format!("{:016x}", scene.photon_hash),
         "method": method_name,
         "label": label,
         "spp": spp,

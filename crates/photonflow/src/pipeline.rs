@@ -13,6 +13,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use store::{Expect, Header, MapKind, MappedStore, StoreWriter};
 
+/// Bump when `emit` changes which photons it stores or what they carry.
+pub const PHOTON_TRACER_VERSION: u32 = 1;
+
 /// Where the photon sets of one (scene, parameters) pair live in a cache directory.
 pub struct CacheKey {
     pub scene_hash: u64,
@@ -23,9 +26,12 @@ pub struct CacheKey {
 impl CacheKey {
     pub fn new(scene: &Scene, params: &EmitParams) -> CacheKey {
         let params_json = serde_json::to_string(params).expect("EmitParams serialises");
+        // The tracer's version joins the parameters: a change to how photons are traced
+        // must not serve photon files made by the old rules.
+        let keyed = format!("v{PHOTON_TRACER_VERSION} {params_json}");
         CacheKey {
-            scene_hash: scene.content_hash,
-            params_hash: scene::fnv1a64(params_json.as_bytes()),
+            scene_hash: scene.photon_hash,
+            params_hash: scene::fnv1a64(keyed.as_bytes()),
             params_json,
         }
     }

@@ -69,6 +69,8 @@ pub fn path(a: RenderArgs) -> Result<(), String> {
     let json = serde_json::json!({
         "scene": a.scene.display().to_string(),
         "scene_hash": format!("{:016x}", s.content_hash),
+        "image_hash": format!("{:016x}", s.image_hash),
+        "photon_hash": format!("{:016x}", s.photon_hash),
         "method": "path",
         "spp": spp,
         "caustics": !a.no_caustics,

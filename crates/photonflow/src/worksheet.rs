@@ -44,7 +44,7 @@ pub fn run(a: &WorksheetArgs) -> Result<(), String> {
         .ok()
         .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
         .is_some_and(|j| {
-            j["scene_hash"] == format!("{:016x}", scene.content_hash)
+            j["image_hash"] == format!("{:016x}", scene.image_hash)
                 && j["spp"].as_u64().unwrap_or(0) >= a.reference_spp as u64
         });
     if reusable {

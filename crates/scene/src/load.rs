@@ -31,9 +31,14 @@ pub struct Scene {
     pub emission: Vec<Vec3>,
     pub lights: Vec<AreaLight>,
     pub camera: Camera,
-    /// FNV-1a hash of the scene file and every file it names, in order: photon caches are
-    /// keyed by it, so any edit to any input invalidates them.
+    /// FNV-1a hash of the scene file and every file it names, in order.
     pub content_hash: u64,
+    /// Hash of what photons depend on: the files the scene names, the seed, meshes, spheres
+    /// and materials (not the camera, `[render]` or `[estimate]`, so editing an estimator or
+    /// the camera never invalidates a photon cache). Emission parameters are keyed apart.
+    pub photon_hash: u64,
+    /// `photon_hash` plus the camera and `[render]`: what a path-traced image depends on.
+    pub image_hash: u64,
 }
 
 impl Scene {
@@ -81,9 +86,39 @@ impl Scene {
                 format!("malformed scene file: {}", e.message()) + &location(text, e.span()),
             )
         })?;
+        // The builder hashes the files the scene names; the scene text joins per use below.
         let mut hash = Fnv::new();
-        hash.write(text.as_bytes());
-        Builder::new(path, &file, &mut hash).build(file.clone())
+        let mut scene = Builder::new(path, &file, &mut hash).build(file.clone())?;
+        let files = hash.finish();
+        let inputs = |f: &SceneFile, camera: bool| -> String {
+            #[derive(serde::Serialize)]
+            struct Inputs<'a> {
+                files: u64,
+                seed: u64,
+                meshes: &'a [crate::MeshDesc],
+                spheres: &'a [crate::SphereDesc],
+                materials: &'a std::collections::BTreeMap<String, crate::MaterialDesc>,
+                camera: Option<&'a crate::CameraDesc>,
+                render: Option<&'a RenderSettings>,
+            }
+            toml::to_string(&Inputs {
+                files,
+                seed: f.seed,
+                meshes: &f.meshes,
+                spheres: &f.spheres,
+                materials: &f.materials,
+                camera: camera.then_some(&f.camera),
+                render: camera.then_some(&f.render),
+            })
+            .unwrap_or_default()
+        };
+        scene.photon_hash = fnv1a64(inputs(&file, false).as_bytes());
+        scene.image_hash = fnv1a64(inputs(&file, true).as_bytes());
+        let mut all = Fnv::new();
+        all.write(&files.to_le_bytes());
+        all.write(text.as_bytes());
+        scene.content_hash = all.finish();
+        Ok(scene)
     }
 }
 
@@ -240,20 +275,46 @@ impl<'a> Builder<'a> {
                 continue;
             }
             let area = self.mesh.area(t);
-            let n = self.mesh.face_normal(t);
-            if area.is_nan() || area <= 0.0 || n.try_normalize().is_none() {
+            // In f64: an f32 cross product of a huge triangle overflows while normalising.
+            let [p0, p1, p2] = self.mesh.vertices(t).map(|p| p.as_dvec3());
+            let n = (p1 - p0).cross(p2 - p0).normalize_or_zero().as_vec3();
+            let name = &self.names[self.mesh.materials[t] as usize];
+            if area.is_infinite() || !n.is_finite() {
                 return Err(self.err(format!(
-                    "zero-area light: triangle {t} (material `{}`) emits but has no area",
-                    self.names[self.mesh.materials[t] as usize]
+                    "light triangle {t} (material `{name}`) is too large for f32 (area {area}): \
+                     check the mesh's scale"
+                )));
+            }
+            if area.is_nan() || area <= 0.0 || n == Vec3::ZERO {
+                return Err(self.err(format!(
+                    "zero-area light: triangle {t} (material `{name}`) emits but has no area"
+                )));
+            }
+            let power = (std::f64::consts::PI * area as f64 * e.as_dvec3()).as_vec3();
+            if !power.is_finite() {
+                return Err(self.err(format!(
+                    "light triangle {t} (material `{name}`): power pi * area * Le = {} x {:?} \
+                     overflows f32",
+                    std::f64::consts::PI * area as f64,
+                    e.to_array()
                 )));
             }
             lights.push(AreaLight {
                 triangle: t as u32,
                 area,
                 le: e,
-                normal: n.normalize(),
-                power: (std::f64::consts::PI * area as f64 * e.as_dvec3()).as_vec3(),
+                normal: n,
+                power,
             });
+        }
+        let total = lights
+            .iter()
+            .fold(DVec3::ZERO, |a, l| a + l.power.as_dvec3());
+        if !total.as_vec3().is_finite() {
+            return Err(self.err(format!(
+                "the lights' total power {:?} overflows f32: emission or light size is absurd",
+                total.to_array()
+            )));
         }
         if lights.is_empty() {
             let hint = if file.meshes.iter().any(|m| m.emission == EmissionSource::Ke) {
@@ -282,6 +343,8 @@ impl<'a> Builder<'a> {
             lights,
             camera,
             content_hash,
+            photon_hash: 0,
+            image_hash: 0,
         })
     }
 

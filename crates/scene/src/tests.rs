@@ -160,6 +160,25 @@ fn content_hash_changes_with_any_input() {
     let edited = text.replace("ior = 1.5", "ior = 1.51");
     let c = Scene::from_toml(&scenes_dir().join("cornell-spheres/analytic.toml"), &edited).unwrap();
     assert_ne!(a.content_hash, c.content_hash);
+    assert_ne!(
+        a.photon_hash, c.photon_hash,
+        "a material change changes the photons"
+    );
+    // The camera, [render] and [estimate] do not change photons; the camera changes images.
+    let d = Scene::from_toml(
+        &scenes_dir().join("cornell-spheres/analytic.toml"),
+        &(text.replace("vfov = 53.13", "vfov = 50") + "\n[estimate.global]\nk = 20\n"),
+    )
+    .unwrap();
+    assert_ne!(a.content_hash, d.content_hash);
+    assert_eq!(a.photon_hash, d.photon_hash);
+    assert_ne!(a.image_hash, d.image_hash);
+    let e = Scene::from_toml(
+        &scenes_dir().join("cornell-spheres/analytic.toml"),
+        &(text.clone() + "\n[estimate.global]\nk = 20\n"),
+    )
+    .unwrap();
+    assert_eq!(a.image_hash, e.image_hash);
 }
 
 /// A scratch directory with the given files; removed on drop.
@@ -403,5 +422,33 @@ fn broken_obj_and_mtl_syntax_are_named() {
         ],
         "a.obj",
         "",
+    );
+}
+
+#[test]
+fn absurd_light_power_or_size_is_refused_not_overflowed() {
+    // Finite emission times area can overflow f32 power, which used to panic downstream.
+    let mtl = GOOD_MTL.replace("Ke 4 4 4", "Ke 3e38 3e38 3e38");
+    let toml = scene_toml("a.obj").replace("obj = \"a.obj\"", "obj = \"a.obj\"\nscale = 4");
+    error_of(
+        "power",
+        &[("s.toml", &toml), ("a.obj", GOOD_OBJ), ("m.mtl", &mtl)],
+        "s.toml",
+        "overflows f32",
+    );
+    let mtl = GOOD_MTL.replace("Ke 4 4 4", "Ke 3e38 0 0");
+    let toml = scene_toml("a.obj").replace("obj = \"a.obj\"", "obj = \"a.obj\"\nscale = 40");
+    error_of(
+        "power1",
+        &[("s.toml", &toml), ("a.obj", GOOD_OBJ), ("m.mtl", &mtl)],
+        "s.toml",
+        "overflows f32",
+    );
+    let toml = scene_toml("a.obj").replace("obj = \"a.obj\"", "obj = \"a.obj\"\nscale = 1e25");
+    error_of(
+        "huge",
+        &[("s.toml", &toml), ("a.obj", GOOD_OBJ), ("m.mtl", GOOD_MTL)],
+        "s.toml",
+        "too large",
     );
 }
