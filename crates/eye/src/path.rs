@@ -131,7 +131,7 @@ const MAX_SURVIVAL: f32 = 0.95;
 /// shading normal, only if the geometric normal agrees. Otherwise the pair would carry light
 /// through the surface (or stop it at the surface) where the true geometry does the opposite.
 #[inline]
-fn sides_agree(wo: Vec3, wi: Vec3, ng: Vec3, wo_l: Vec3, wi_l: Vec3) -> bool {
+pub(crate) fn sides_agree(wo: Vec3, wi: Vec3, ng: Vec3, wo_l: Vec3, wi_l: Vec3) -> bool {
     let geometric_reflection = wo.dot(ng) * wi.dot(ng) > 0.0;
     let shading_reflection = wo_l.z * wi_l.z > 0.0;
     geometric_reflection == shading_reflection

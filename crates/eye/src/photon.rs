@@ -155,16 +155,22 @@ impl Ctx<'_> {
                 _ => {
                     let frame = Frame::from_z(hit.ns);
                     let bsdf = self.bsdfs[hit.material as usize];
-                    let Some(s) =
-                        bsdf.sample(frame.to_local(wo), u_lobe, u_dir, TransportMode::Radiance)
-                    else {
+                    let wo_l = frame.to_local(wo);
+                    let Some(s) = bsdf.sample(wo_l, u_lobe, u_dir, TransportMode::Radiance) else {
                         break;
                     };
+                    let wi = frame.to_world(s.wi);
+                    // As in the path tracer: end the path where shading and geometric normals
+                    // disagree on reflection vs transmission (pbrt-v4 §10.1.1), so both passes
+                    // follow the same paths near smooth-shaded silhouettes.
+                    if !crate::path::sides_agree(wo, wi, hit.point.n, wo_l, s.wi) {
+                        break;
+                    }
                     beta *= s.weight();
                     if beta == Vec3::ZERO {
                         break;
                     }
-                    ray = hit.point.spawn_ray(frame.to_world(s.wi));
+                    ray = hit.point.spawn_ray(wi);
                 }
             }
         }

@@ -158,27 +158,47 @@ thread_local! {
     };
 }
 
-impl Irradiance for Maps<'_> {
-    fn irradiance(&self, map: MapLookup, p: Vec3, n: Vec3) -> Vec3 {
+impl Maps<'_> {
+    /// The estimate from the maps themselves (no cache): irradiance and the radius used,
+    /// with the boundary correction for the global map when asked for. `hint` carries the
+    /// previous query's radius (exact either way; density's `knn_hinted`).
+    fn estimate(
+        &self,
+        map: MapLookup,
+        p: Vec3,
+        n: Vec3,
+        hint: &mut KnnHint,
+        scratch: &mut Vec<Neighbor>,
+    ) -> (Vec3, f32) {
         let (m, params) = match map {
             MapLookup::Global => (&self.global, &self.gp),
             MapLookup::Caustic => (&self.caustic, &self.cp),
         };
-        let Some(m) = m else { return Vec3::ZERO };
-        if let (MapLookup::Global, Some(c)) = (map, &self.gather_cache) {
-            return c.lookup(p, n);
+        let Some(m) = m else {
+            return (Vec3::ZERO, 0.0);
+        };
+        let e = m.irradiance_hinted(p, n, params, hint, scratch);
+        match (map, self.boundary) {
+            // The hint now holds the radius the estimate used.
+            (MapLookup::Global, Some(scene)) if !scratch.is_empty() => {
+                let mass = kernel_mass_on_surface(scene, p, n, hint.r, params.kernel);
+                (e / mass.max(MIN_MASS), hint.r)
+            }
+            _ => (e, hint.r),
+        }
+    }
+}
+
+impl Irradiance for Maps<'_> {
+    fn irradiance(&self, map: MapLookup, p: Vec3, n: Vec3) -> Vec3 {
+        if let (MapLookup::Global, Some(c)) = (map, &self.gather_cache)
+            && let Some(e) = c.lookup(p, n)
+        {
+            return e;
         }
         STATE.with_borrow_mut(|st| {
             let hint = &mut st.hints[(map == MapLookup::Caustic) as usize];
-            let e = m.irradiance_hinted(p, n, params, hint, &mut st.scratch);
-            match (map, self.boundary) {
-                // The hint now holds the radius the estimate used.
-                (MapLookup::Global, Some(scene)) if !st.scratch.is_empty() => {
-                    let mass = kernel_mass_on_surface(scene, p, n, hint.r, params.kernel);
-                    e / mass.max(MIN_MASS)
-                }
-                _ => e,
-            }
+            self.estimate(map, p, n, hint, &mut st.scratch).0
         })
     }
 }
@@ -230,9 +250,19 @@ pub(crate) fn kernel_mass_on_surface(
     if all > 0.0 { (on / all) as f32 } else { 1.0 }
 }
 
+/// Most photons one map may hold: the kd-tree indexes with u32.
+const MAX_MAP_PHOTONS: u64 = u32::MAX as u64 - 1;
+
 fn load_map(path: &Path, key: &CacheKey, kind: MapKind) -> Result<PhotonMap, String> {
     let store = MappedStore::open(path).map_err(|e| e.to_string())?;
     store.check(&key.expect(kind)).map_err(|e| e.to_string())?;
+    if store.header().stored > MAX_MAP_PHOTONS {
+        return Err(format!(
+            "{}: {} photons exceed the {MAX_MAP_PHOTONS} one map can index",
+            path.display(),
+            store.header().stored
+        ));
+    }
     // Photon powers from `emit` already carry the 1/N of the emitted count the header records,
     // so the map divides by 1.
     Ok(PhotonMap::build(store.to_vec(), 1, IndexKind::KdTree))
@@ -252,9 +282,33 @@ pub fn estimate(scene: &Scene, a: &EstimateArgs) -> Result<EstimateOutput, Strin
         PhotonMethod::GlobalDirect => vec![MapKind::Global],
         PhotonMethod::FinalGather { .. } => pipeline::planned_kinds(&plan),
     };
-    if needed.contains(&MapKind::Global) && !plan.global {
+    // Both methods read the global map as the full light arriving at a surface, direct hits
+    // included; final gathering also needs the caustic map wherever the scene can make
+    // caustics. A missing set would silently darken a layer, so it is an error.
+    let incomplete = if !plan.global {
+        Some(
+            "the effects plan traces no global photons (no diffuse surface, or [photons] global = false)",
+        )
+    } else if !emit_params.store_direct {
+        Some(
+            "[photons] store_direct = false leaves direct light out of the global map these methods read",
+        )
+    } else if matches!(a.method, PhotonMethod::FinalGather { .. })
+        && !emit_params.caustic
+        && scene.materials.iter().any(|m| m.is_specular())
+    {
+        Some("[photons] caustic = false leaves the caustic layer of final gathering empty")
+    } else {
+        None
+    };
+    if let Some(why) = incomplete {
+        return Err(format!("{}: {why}", scene.path.display()));
+    }
+    if a.boundary && params(scene, a)?.0.topo.is_none() {
         return Err(format!(
-            "{}: the effects plan traces no global photons",
+            "{}: --boundary needs the topological test (--topo EPS): the correction divides by \
+             the share of the disc on this surface, so photons from other surfaces must be \
+             excluded first or they are amplified too",
             scene.path.display()
         ));
     }
@@ -269,6 +323,12 @@ pub fn estimate(scene: &Scene, a: &EstimateArgs) -> Result<EstimateOutput, Strin
             ));
         }
         let m = load_map(&path, &key, kind)?;
+        if m.is_empty() && kind == MapKind::Global {
+            eprintln!(
+                "warning: {}: the global photon set is empty",
+                path.display()
+            );
+        }
         match kind {
             MapKind::Global => global = Some(m),
             MapKind::Caustic => caustic = Some(m),
@@ -276,30 +336,42 @@ pub fn estimate(scene: &Scene, a: &EstimateArgs) -> Result<EstimateOutput, Strin
     }
     let t_load = t0.elapsed().as_secs_f64();
     let (gp, cp) = params(scene, a)?;
-    let t_cache = Instant::now();
-    let gather_cache = match (a.method, &global) {
-        (PhotonMethod::FinalGather { .. }, Some(g)) if a.gather_cache > 0 => {
-            Some(IrradianceCache::build(scene, g, &gp, a.gather_cache))
-        }
-        _ => None,
-    };
-    let t_cache = t_cache.elapsed().as_secs_f64();
-    if let Some(c) = &gather_cache {
-        println!(
-            "irradiance cache: {} points (every {}th global photon) in {t_cache:.2} s",
-            c.len(),
-            a.gather_cache
-        );
-    }
-    let maps = Maps {
+    let mut maps = Maps {
         global,
         caustic,
         gp,
         cp,
         boundary: a.boundary.then_some(scene),
-        gather_cache,
+        gather_cache: None,
     };
+    let t_cache = Instant::now();
+    if let (PhotonMethod::FinalGather { .. }, true) = (a.method, a.gather_cache > 0) {
+        // The cache stores exactly what a direct lookup would answer at its points,
+        // boundary correction included.
+        let c = IrradianceCache::build(
+            scene,
+            maps.global.as_ref(),
+            a.gather_cache,
+            &|x, n, h, s| maps.estimate(MapLookup::Global, x, n, h, s),
+        );
+        println!(
+            "irradiance cache: {} points (every {}th global photon) in {:.2} s",
+            c.len(),
+            a.gather_cache,
+            t_cache.elapsed().as_secs_f64()
+        );
+        maps.gather_cache = Some(c);
+    }
+    let t_cache = t_cache.elapsed().as_secs_f64();
     let spp = a.spp.unwrap_or(1);
+    if a.threads == Some(0) {
+        return Err("--threads must be at least 1".into());
+    }
+    if let PhotonMethod::FinalGather { rays } = a.method
+        && rays > 1 << 16
+    {
+        return Err(format!("--gather-rays {rays} is absurd (at most 65536)"));
+    }
     if spp == 0 || spp > 1 << 20 {
         return Err(format!("--spp {spp} must be in 1..=1048576"));
     }

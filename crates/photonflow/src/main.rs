@@ -75,7 +75,8 @@ enum Cmd {
         method: Option<String>,
         #[command(flatten)]
         photon: PhotonArgs,
-        /// Samples per pixel (default: the scene file's render.spp).
+        /// Samples per pixel (default: the scene file's render.spp for `path`, 1 for the photon
+        /// methods, which already average many photons per estimate).
         #[arg(long)]
         spp: Option<u32>,
         /// Leave out L S+ D paths (caustics) so a caustic layer made elsewhere can be added.
@@ -331,7 +332,14 @@ fn run(cmd: Cmd) -> Result<(), String> {
             out,
             exposure,
         } => {
+            if method.as_deref() == Some("path") {
+                return Err(
+                    "estimate reads photon maps: use `render --method path` for the path tracer"
+                        .into(),
+                );
+            }
             let (m, rays) = method_of(&scene, method)?;
+            // A scene whose default is the path tracer still gets a photon method here.
             let m = if m == "path" {
                 "global-direct".to_string()
             } else {

@@ -377,3 +377,57 @@ fn render_without_a_method_runs_the_framework_standard_deterministically() {
     }
     assert_eq!(images[0], images[1], "1 and 2 threads give the same image");
 }
+
+#[test]
+fn estimates_that_would_be_silently_wrong_are_refused() {
+    let dir = Scratch::new("refuse", &[]);
+    let cache = dir.0.join("cache");
+    let cache_s = cache.to_str().unwrap();
+    let scene = "scenes/corner/corner.toml";
+    let o = photonflow(&["trace", scene, "--photons", "2000", "--cache", cache_s]);
+    assert!(o.status.success());
+    // The boundary correction without the topological test would amplify leaked photons.
+    let o = photonflow(&[
+        "estimate",
+        scene,
+        "--photons",
+        "2000",
+        "--cache",
+        cache_s,
+        "--boundary",
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains("--boundary needs the topological test"), "{e}");
+    // The path tracer is not an estimate.
+    let o = photonflow(&["estimate", scene, "--method", "path", "--cache", cache_s]);
+    assert_eq!(o.status.code(), Some(1));
+    // A global map without direct hits would lose direct light in both photon methods.
+    let obj = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/corner/corner.obj"
+    );
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/corner/corner.toml"
+    ))
+    .unwrap()
+    .replace("obj = \"corner.obj\"", &format!("obj = {obj:?}"))
+        + "\n[photons]\nstore_direct = false\n";
+    let s = dir.0.join("nodirect.toml");
+    std::fs::write(&s, text).unwrap();
+    let o = photonflow(&[
+        "render",
+        s.to_str().unwrap(),
+        "--method",
+        "global-direct",
+        "--cache",
+        cache_s,
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("store_direct = false") && e.contains("nodirect.toml"),
+        "{e}"
+    );
+}
