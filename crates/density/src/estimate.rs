@@ -43,14 +43,23 @@ impl Default for EstimateParams {
     }
 }
 
+/// What the estimate loop reads per neighbour (see `PhotonMap::hot`).
+#[derive(Clone, Copy, Debug)]
+struct Hot {
+    dir: Vec3,
+    power: Vec3,
+}
+
 /// Photons plus a spatial index over their positions.
 pub struct PhotonMap {
     photons: Vec<Photon>,
-    /// `photons[i].direction()`, decoded once at build: the same-side test reads it for
-    /// every neighbour of every query (k = 1000 over 512² pixels is 2.6e8 reads), and the
-    /// octahedral decode (a divide and a normalise, in another crate so not inlined) cost
-    /// a third of a k = 1000 estimate. 12 bytes per photon.
-    dirs: Vec<Vec3>,
+    /// `photons[i].direction()`, decoded once at build, and `photons[i].power`: the
+    /// estimate loop reads these two for every neighbour of every query (k = 1000 over
+    /// 512² pixels is 2.6e8 reads); the octahedral decode (a divide and a normalise, in
+    /// another crate so not inlined) cost a third of a k = 1000 estimate, and one 24-byte
+    /// record with one bounds check beats a 32-byte photon plus a direction. 24 bytes per
+    /// photon.
+    hot: Vec<Hot>,
     index: Index,
     emitted: u64,
 }
@@ -71,10 +80,16 @@ impl PhotonMap {
             }
             index => (photons, index),
         };
-        let dirs = photons.iter().map(Photon::direction).collect();
+        let hot = photons
+            .iter()
+            .map(|p| Hot {
+                dir: p.direction(),
+                power: p.power(),
+            })
+            .collect();
         PhotonMap {
             photons,
-            dirs,
+            hot,
             index,
             emitted,
         }
@@ -182,28 +197,104 @@ impl PhotonMap {
         }
         let drop = p.drop_kth && on_boundary;
         let inv_r2 = 1.0 / r2;
-        let mut sum = DVec3::ZERO;
-        for nb in neighbors {
-            if drop && nb.key() == kth {
-                continue;
+        // One loop per kernel (the `match` hoisted out; `shape` inlines to its own arm).
+        // Each closure takes u = d2 / r² and returns exactly `shape(sqrt(u))`: the uniform
+        // kernel needs no square root, since sqrt rounds correctly and monotonically, so
+        // sqrt(u) > 1 exactly when u > 1 + ε (sqrt(1 + ε) rounds down to 1, sqrt(1 + 2ε)
+        // up to 1 + ε). The others keep the root: t·t is not u to the last bit.
+        // Dropping the k-th photon: sum around it (keys are unique, indices being unique).
+        let skip = if drop {
+            neighbors.iter().position(|nb| nb.key() == kth)
+        } else {
+            None
+        };
+        let f = Filter {
+            x,
+            n,
+            skip,
+            same_side: p.same_side,
+            topo: p.topo,
+            inv_r2,
+        };
+        let sum = match p.kernel {
+            Kernel::Uniform => self.sum(&f, neighbors, |u| {
+                if u > 1.0 + f64::EPSILON { 0.0 } else { 1.0 }
+            }),
+            Kernel::Cone { k } => self.sum(&f, neighbors, |u| Kernel::Cone { k }.shape(u.sqrt())),
+            Kernel::Gaussian => self.sum(&f, neighbors, |u| Kernel::Gaussian.shape(u.sqrt())),
+            Kernel::GaussianJensen => {
+                self.sum(&f, neighbors, |u| Kernel::GaussianJensen.shape(u.sqrt()))
             }
-            let ph = &self.photons[nb.index as usize];
-            if p.same_side && self.dirs[nb.index as usize].dot(n) >= 0.0 {
-                continue;
+            Kernel::Epanechnikov => {
+                self.sum(&f, neighbors, |u| Kernel::Epanechnikov.shape(u.sqrt()))
             }
-            if let Some(eps) = p.topo {
-                let v = ph.position() - x;
-                let len = v.length();
-                // A photon at x itself lies in every tangent plane.
-                if len > 0.0 && n.dot(v).abs() >= eps * len {
-                    continue;
-                }
-            }
-            let t = (nb.d2 as f64 * inv_r2).sqrt();
-            sum += ph.power().as_dvec3() * p.kernel.shape(t);
-        }
+            Kernel::Silverman => self.sum(&f, neighbors, |u| Kernel::Silverman.shape(u.sqrt())),
+            Kernel::Triweight => self.sum(&f, neighbors, |u| Kernel::Triweight.shape(u.sqrt())),
+        };
         let e = sum * (p.kernel.norm() * inv_r2 / self.emitted.max(1) as f64);
         e.as_vec3().clamp(Vec3::ZERO, Vec3::splat(f32::MAX))
+    }
+
+    /// Σ Φ_p shape(d2_p / r²) over the neighbours passing `f`'s tests, in the order given,
+    /// in f64: one loop per combination of the tests (`sum_with`).
+    #[inline(always)]
+    fn sum(&self, f: &Filter, neighbors: &[Neighbor], shape: impl Fn(f64) -> f64) -> DVec3 {
+        match (f.same_side, f.topo.is_some()) {
+            (false, false) => self.sum_with::<false, false>(f, neighbors, shape),
+            (true, false) => self.sum_with::<true, false>(f, neighbors, shape),
+            (false, true) => self.sum_with::<false, true>(f, neighbors, shape),
+            (true, true) => self.sum_with::<true, true>(f, neighbors, shape),
+        }
+    }
+
+    /// [`PhotonMap::sum`] with the same-side and topological tests fixed at compile time.
+    /// The neighbour at `f.skip` is left out by summing the slices either side of it.
+    #[inline(always)]
+    fn sum_with<const SAME_SIDE: bool, const TOPO: bool>(
+        &self,
+        f: &Filter,
+        neighbors: &[Neighbor],
+        shape: impl Fn(f64) -> f64,
+    ) -> DVec3 {
+        let (head, tail) = match f.skip {
+            Some(i) => (&neighbors[..i], &neighbors[i + 1..]),
+            None => (neighbors, &neighbors[..0]),
+        };
+        let sum = self.sum_slice::<SAME_SIDE, TOPO>(f, head, DVec3::ZERO, &shape);
+        self.sum_slice::<SAME_SIDE, TOPO>(f, tail, sum, &shape)
+    }
+
+    /// `sum` plus the terms of `neighbors`, in order. Every neighbour's weight is computed
+    /// (no branch on the tests before the arithmetic); a rejected one leaves the sum as is.
+    #[inline(always)]
+    fn sum_slice<const SAME_SIDE: bool, const TOPO: bool>(
+        &self,
+        f: &Filter,
+        neighbors: &[Neighbor],
+        mut sum: DVec3,
+        shape: &impl Fn(f64) -> f64,
+    ) -> DVec3 {
+        let eps = f.topo.unwrap_or(0.0);
+        for nb in neighbors {
+            let i = nb.index as usize;
+            let h = self.hot[i];
+            let mut keep = true;
+            // Not `dot < 0`: a NaN dot product keeps the photon, as it always has.
+            if SAME_SIDE && h.dir.dot(f.n) >= 0.0 {
+                keep = false;
+            }
+            if TOPO {
+                let v = self.photons[i].position() - f.x;
+                let len = v.length();
+                // A photon at x itself lies in every tangent plane.
+                keep &= !(len > 0.0 && f.n.dot(v).abs() >= eps * len);
+            }
+            let c = h.power.as_dvec3() * shape(nb.d2 as f64 * f.inv_r2);
+            if keep {
+                sum += c;
+            }
+        }
+        sum
     }
 
     /// Radiance leaving a Lambertian surface of albedo `rho` at `x`: ρ/π · E.
@@ -217,6 +308,17 @@ impl PhotonMap {
     ) -> Vec3 {
         radiance_lambertian(self.irradiance(x, n, p, scratch), rho)
     }
+}
+
+/// The per-query constants of [`PhotonMap::irradiance_from_neighbors`]'s sum.
+struct Filter {
+    x: Vec3,
+    n: Vec3,
+    /// Position in `neighbors` of the one neighbour to leave out.
+    skip: Option<usize>,
+    same_side: bool,
+    topo: Option<f32>,
+    inv_r2: f64,
 }
 
 /// L = ρ/π · E for a Lambertian surface of albedo ρ.

@@ -120,6 +120,9 @@ pub struct KdTree {
     xyz: [Vec<f32>; 3],
     ids: Vec<u32>,
     axis: Vec<u8>,
+    /// `ids[i] == i` for every slot (after [`KdTree::relabel_by_slot`]): results need no
+    /// relabelling.
+    identity: bool,
 }
 
 /// Ranges of at most this many points are scanned linearly. 16 beat 8 and 32 at 1M
@@ -167,7 +170,12 @@ impl KdTree {
         }
         let xyz = [0, 1, 2].map(|a| items.iter().map(|(p, _)| p[a]).collect());
         let ids = items.into_iter().map(|(_, i)| i).collect();
-        KdTree { xyz, ids, axis }
+        KdTree {
+            xyz,
+            ids,
+            axis,
+            identity: false,
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -195,6 +203,7 @@ impl KdTree {
         for (i, id) in self.ids.iter_mut().enumerate() {
             *id = i as u32;
         }
+        self.identity = true;
     }
 
     /// The `k` nearest points with `d2 <= r_max^2`, sorted by `(d2, index)`, into `out`.
@@ -268,9 +277,11 @@ impl KdTree {
     /// Fixed-radius search: every point with `d2 <= r2` as `(slot, d2)`, in slot order (an
     /// in-order walk: left range, node point, right range), so the output order depends on
     /// the set alone. Gives up (returns false, `out` partial) once more than `cap` are in.
+    /// `out`'s old entries are overwritten, not cleared first: its length is room to write
+    /// into without zero-filling it again (a resize writes every new entry).
     fn gather(&self, q: [f32; 3], r2: f32, cap: usize, out: &mut Vec<Neighbor>) -> bool {
-        out.clear();
         if self.is_empty() {
+            out.clear();
             return true;
         }
         let mut len = 0;
@@ -302,13 +313,18 @@ impl KdTree {
                 if out.len() < len + LEAF {
                     out.resize(2 * out.len() + LEAF, Neighbor { index: 0, d2: 0.0 });
                 }
+                // `kept <= j < LEAF`, so the mask never changes it; it lets the compiler drop
+                // the bounds check.
+                let dst = &mut out[len..len + LEAF];
+                let mut kept = 0;
                 for (j, &d2) in d2s[..m].iter().enumerate() {
-                    out[len] = Neighbor {
+                    dst[kept & (LEAF - 1)] = Neighbor {
                         index: (lo + j) as u32,
                         d2,
                     };
-                    len += (d2 <= r2) as usize;
+                    kept += (d2 <= r2) as usize;
                 }
+                len += kept;
                 if len > cap {
                     out.truncate(len);
                     return false;
@@ -358,8 +374,8 @@ impl KdTree {
         hint: &mut KnnHint,
         out: &mut Vec<Neighbor>,
     ) {
-        out.clear();
         if k == 0 || self.is_empty() {
+            out.clear();
             return;
         }
         let qa = q.to_array();
@@ -392,8 +408,10 @@ impl KdTree {
             self.gather(qa, r2, usize::MAX, out);
         }
         // Slots to indices before selecting: ties break by index.
-        for n in out.iter_mut() {
-            n.index = self.ids[n.index as usize];
+        if !self.identity {
+            for n in out.iter_mut() {
+                n.index = self.ids[n.index as usize];
+            }
         }
         keep_k_smallest(out, k);
         hint.update(q, k, r_max, out);
@@ -408,29 +426,42 @@ fn grow2(k: usize, found: usize) -> f32 {
 }
 
 /// Keep the k smallest `(d2, index)` of `out`, in their order. Selection by bucketing:
-/// d2 ↦ ⌊256 d2 / max d2⌋ is monotone, so counting per bucket finds the bucket holding the
-/// k-th key in one pass; only that bucket (a few points, as d2 is near uniform on a
+/// d2 ↦ round(256 d2 / max d2) is monotone, so counting per bucket finds the bucket holding
+/// the k-th key in one pass; only that bucket (a few points, as d2 is near uniform on a
 /// surface) is selected exactly, in `out`'s spare tail. A radix select (Alabi et al. 2012,
 /// "Fast k-selection algorithms for graphics processing units", bucket select): one
-/// counting pass instead of introselect's repeated partitions of all candidates (not
-/// measured separately from the whole hinted path).
+/// counting pass instead of introselect's repeated partitions of all candidates.
+///
+/// The bucket is computed without a float-to-integer conversion: for 0 <= v <= 2^22,
+/// v + 2^23 has exponent 23, so its low mantissa bits are v rounded to an integer (the
+/// usual "magic number" trick). Rounding is monotone like the floor, which is all the
+/// selection needs. Two histograms, alternating, so runs of equal buckets (neighbouring
+/// points in slot order) do not serialise on one counter.
 fn keep_k_smallest(out: &mut Vec<Neighbor>, k: usize) {
     const B: usize = 256;
+    const MAGIC: f32 = 8_388_608.0; // 2^23
     let m = out.len();
     if m <= k {
         return;
     }
     let hi = out.iter().fold(0f32, |a, n| a.max(n.d2));
     let scale = B as f32 / hi;
-    let bucket = |d2: f32| ((d2 * scale) as usize).min(B - 1);
+    // In 0..=B (d2 * scale <= B up to rounding, which rounds to B at most): B + 1 buckets.
+    let bucket =
+        |d2: f32| ((d2 * scale + MAGIC).to_bits().wrapping_sub(MAGIC.to_bits()) as usize) & 511;
     let below = if scale.is_finite() && scale > 0.0 {
-        let mut counts = [0u32; B];
-        for n in out.iter() {
-            counts[bucket(n.d2)] += 1;
+        let mut counts = [[0u32; 512]; 2];
+        let mut pairs = out.chunks_exact(2);
+        for pair in &mut pairs {
+            counts[0][bucket(pair[0].d2)] += 1;
+            counts[1][bucket(pair[1].d2)] += 1;
+        }
+        for n in pairs.remainder() {
+            counts[0][bucket(n.d2)] += 1;
         }
         let (mut b, mut below) = (0, 0);
-        while below + (counts[b] as usize) < k {
-            below += counts[b] as usize;
+        while below + ((counts[0][b] + counts[1][b]) as usize) < k {
+            below += (counts[0][b] + counts[1][b]) as usize;
             b += 1;
         }
         for i in 0..m {
@@ -447,8 +478,15 @@ fn keep_k_smallest(out: &mut Vec<Neighbor>, k: usize) {
     let tail = &mut out[m..];
     let (_, kth, _) = tail.select_nth_unstable_by_key(k - below - 1, |n| n.key());
     let kth = kth.key();
-    out.truncate(m);
-    out.retain(|n| n.key() <= kth);
+    // Branch-free compaction (as in `KdTree::gather`): every entry is written, and kept
+    // by advancing `len`.
+    let mut len = 0;
+    for i in 0..m {
+        let n = out[i];
+        out[len] = n;
+        len += (n.key() <= kth) as usize;
+    }
+    out.truncate(len);
 }
 
 /// A radius guess for `knn_hinted`: the previous query's point and its k-th distance
