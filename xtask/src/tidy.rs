@@ -80,6 +80,12 @@ mod tests {
                 "{krate}: add `[lints] workspace = true`"
             );
             let Some((_, allowed)) = ALLOWED.iter().find(|(k, _)| *k == krate) else {
+                // Only the binary may see every crate; a new crate must take its place in the
+                // table (and in ARCHITECTURE.md) first.
+                assert!(
+                    krate == "photonflow",
+                    "{krate} is not in the dependency table of xtask/src/tidy.rs"
+                );
                 continue;
             };
             for dep in local_deps(&manifest, &ours) {
@@ -87,6 +93,40 @@ mod tests {
                     allowed.contains(&dep.as_str()),
                     "{krate} may not depend on {dep} (see xtask/src/tidy.rs and ARCHITECTURE.md)"
                 );
+            }
+        }
+    }
+
+    /// "No IO of a library's own choosing" (ARCHITECTURE.md): outside its tests, a library
+    /// crate touches the filesystem or the environment only if it is one of the IO crates:
+    /// `scene` (the scene file and the files it names), `store` (photon files), `film`
+    /// (images where it is told).
+    #[test]
+    fn libraries_do_no_io_of_their_own() {
+        let io_crates = ["scene", "store", "film", "photonflow"];
+        for krate in our_crates() {
+            if io_crates.contains(&krate.as_str()) {
+                continue;
+            }
+            let mut files = Vec::new();
+            rust_files(&root().join("crates").join(&krate).join("src"), &mut files);
+            for f in files {
+                let name = f.to_string_lossy();
+                if name.contains("/tests") || name.ends_with("bench.rs") {
+                    continue; // tests and benchmarks write scratch files by design
+                }
+                let text = std::fs::read_to_string(&f).unwrap();
+                for banned in [
+                    concat!("std::", "fs"),
+                    concat!("std::", "env"),
+                    concat!("File", "::"),
+                ] {
+                    assert!(
+                        !text.contains(banned),
+                        "{}: `{banned}` in a library",
+                        f.display()
+                    );
+                }
             }
         }
     }
