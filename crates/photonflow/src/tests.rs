@@ -280,3 +280,93 @@ fn the_gather_cache_answers_like_the_map_it_summarises() {
     // Far from every photon (outside the scene) nothing answers.
     assert!(cache.lookup(Vec3::new(50.0, 0.0, 0.0), Vec3::Y).is_none());
 }
+
+#[test]
+fn boundary_correction_removes_the_darkening_at_an_edge_and_a_corner() {
+    // A 4 x 4 floor with photons of uniform density (irradiance E0 = 1) and nothing beyond
+    // it: plain estimates near the edge see half a disc of photons (a quarter in the corner),
+    // corrected ones divide by the kernel mass on the floor and recover E0.
+    use crate::estimate::kernel_mass_on_surface;
+    use density::{EstimateParams, IndexKind, Kernel, KnnHint, PhotonMap};
+    use glam::Vec3;
+    let dir = scratch("edge");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("f.obj"),
+        "mtllib f.mtl\no floor\nusemtl white\nv 0 0 0\nv 0 0 4\nv 4 0 4\nv 4 0 0\nf 1 2 3\nf 1 3 4\n\
+         o light\nusemtl light\nv 1 3 1\nv 3 3 1\nv 3 3 3\nv 1 3 3\nf 5 6 7\nf 5 7 8\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("f.mtl"),
+        "newmtl white\nKd 0.5 0.5 0.5\nnewmtl light\nKe 1 1 1\n",
+    )
+    .unwrap();
+    let text = "[camera]\neye = [2, 5, 2.01]\nlook_at = [2, 0, 2]\nvfov = 60\nwidth = 8\nheight = 8\n\
+                [[mesh]]\nobj = \"f.obj\"\n";
+    let scene = scene::Scene::from_toml(&dir.join("s.toml"), text).unwrap();
+    let mut rng = math::Rng::new(17);
+    let n = 800_000;
+    let power = 16.0 / n as f32; // total flux 16 over area 16: E0 = 1
+    let photons: Vec<store::Photon> = (0..n)
+        .map(|_| {
+            let p = Vec3::new(4.0 * rng.uniform(), 0.0, 4.0 * rng.uniform());
+            store::Photon::new(p, Vec3::splat(power), -Vec3::Y, 0)
+        })
+        .collect();
+    let map = PhotonMap::build(photons, 1, IndexKind::KdTree);
+    // Edge points: 20 along each of the 4 edges, a disc radius (~0.08) or more apart, so the
+    // estimates are nearly independent; corner points: the 4 corners. One k = 1000 estimate
+    // has relative noise ~1.5/sqrt(1000) = 5%: the means then carry ~0.8% (edges) and ~2.4%
+    // (corners), and 0.08 is more than 3 standard errors of either.
+    let edges: Vec<Vec3> = (0..80)
+        .map(|i| {
+            let t = 0.5 + 3.0 * (i % 20) as f32 / 19.0;
+            [
+                Vec3::new(t, 0.0, 0.0),
+                Vec3::new(t, 0.0, 4.0),
+                Vec3::new(0.0, 0.0, t),
+                Vec3::new(4.0, 0.0, t),
+            ][i / 20]
+        })
+        .collect();
+    let corners = vec![
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(4.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 4.0),
+        Vec3::new(4.0, 0.0, 4.0),
+    ];
+    for kernel in [Kernel::Uniform, Kernel::Silverman] {
+        let est = EstimateParams {
+            k: 1000,
+            kernel,
+            topo: Some(0.1),
+            drop_kth: true,
+            ..Default::default()
+        };
+        for (name, points, plain_expect) in [("edge", &edges, 0.5), ("corner", &corners, 0.25)] {
+            let (mut plain, mut corrected) = (0.0f64, 0.0f64);
+            let mut scratch = Vec::new();
+            for &x in points.iter() {
+                let mut hint = KnnHint::NONE;
+                let e = map
+                    .irradiance_hinted(x, Vec3::Y, &est, &mut hint, &mut scratch)
+                    .x;
+                let m = kernel_mass_on_surface(&scene, x, Vec3::Y, hint.r, kernel);
+                plain += e as f64;
+                corrected += (e / m) as f64;
+            }
+            let q = points.len() as f64;
+            let (plain, corrected) = (plain / q, corrected / q);
+            assert!(
+                (plain - plain_expect).abs() < 0.08 * plain_expect * 2.0,
+                "{kernel:?} {name}: plain {plain}"
+            );
+            assert!(
+                (corrected - 1.0).abs() < 0.08,
+                "{kernel:?} {name}: corrected {corrected}"
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
