@@ -22,7 +22,10 @@
 //! machine), queries/s, plain k-NN → hinted k-NN, and irradiance before this change →
 //! hinted irradiance: pixel order k = 50 / 250 / 1000: 296k → 578k, 92k → 243k,
 //! 25k → 81k; irradiance 204k → 502k, 56k → 173k, 19k → 53k. Random order (hint from an
-//! unrelated point of similar density): 186k → 228k, 57k → 112k, 20k → 42k.
+//! unrelated point of similar density): 186k → 228k, 57k → 112k, 20k → 42k. With the
+//! estimate loop compiled once per kernel and test combination (same sums, same order, so
+//! bit-identical), hinted irradiance in pixel order measured 431k / 212k / 82k queries/s on
+//! a quieter machine (`cargo xtask bench knn`, 128² pixels).
 //!
 //! Second decision: kernels are normalised over the unit disc and the estimate is
 //! E = (1/r²) Σ Φ_p K(d_p/r) in f64; r is the k-th distance over *all* candidates, and
