@@ -75,22 +75,11 @@ enum Cmd {
         method: Option<String>,
         #[command(flatten)]
         photon: PhotonArgs,
-        /// Samples per pixel (default: the scene file's render.spp for `path`, 1 for the photon
-        /// methods, which already average many photons per estimate).
-        #[arg(long)]
-        spp: Option<u32>,
+        #[command(flatten)]
+        image: ImageArgs,
         /// Leave out L S+ D paths (caustics) so a caustic layer made elsewhere can be added.
         #[arg(long)]
         no_caustics: bool,
-        /// Worker threads (default: all cores). The image does not depend on it.
-        #[arg(long)]
-        threads: Option<usize>,
-        /// Output directory (default: out/<scene dir>-<scene stem>-<method>).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Exposure of the PNG in stops.
-        #[arg(long, default_value_t = 0.0)]
-        exposure: f32,
     },
     /// Estimate an image from cached photon sets (never traces).
     Estimate {
@@ -101,14 +90,8 @@ enum Cmd {
         method: Option<String>,
         #[command(flatten)]
         photon: PhotonArgs,
-        #[arg(long)]
-        spp: Option<u32>,
-        #[arg(long)]
-        threads: Option<usize>,
-        #[arg(long)]
-        out: Option<PathBuf>,
-        #[arg(long, default_value_t = 0.0)]
-        exposure: f32,
+        #[command(flatten)]
+        image: ImageArgs,
     },
     /// Worksheet 7's deliverable: the global map shown directly with the box kernel, with
     /// Silverman's kernel, and with the topological test; errors against a path-traced
@@ -158,12 +141,31 @@ enum Cmd {
     },
 }
 
+/// Image settings shared by `render` and `estimate`.
+#[derive(clap::Args)]
+struct ImageArgs {
+    /// Samples per pixel (default: the scene file's render.spp for `path`, 1 for the photon
+    /// methods, which already average many photons per estimate).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Output directory (default: out/<scene dir>-<scene stem>-<method>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Exposure of the PNG in stops.
+    #[arg(long, default_value_t = 0.0)]
+    exposure: f32,
+}
+
 /// Photon-mapping settings shared by `estimate` and `render`.
 #[derive(clap::Args)]
 struct PhotonArgs {
     /// Photon paths emitted (default: the scene's [photons] table).
     #[arg(long)]
     photons: Option<u64>,
+    /// Directory of cached photon files.
     #[arg(long, default_value = "out/cache")]
     cache: PathBuf,
     /// Nearest photons per global-map estimate (default: [estimate.global] k, else 1000).
@@ -216,28 +218,20 @@ fn photon_method(name: &str, rays: u32) -> Result<eye::PhotonMethod, String> {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn estimate_args(
-    method: eye::PhotonMethod,
-    p: PhotonArgs,
-    spp: Option<u32>,
-    threads: Option<usize>,
-    out: Option<PathBuf>,
-    exposure: f32,
-) -> estimate::EstimateArgs {
+fn estimate_args(method: eye::PhotonMethod, p: PhotonArgs, i: ImageArgs) -> estimate::EstimateArgs {
     estimate::EstimateArgs {
         method,
         photons: p.photons,
         cache: p.cache,
-        spp,
-        threads,
-        out,
+        spp: i.spp,
+        threads: i.threads,
+        out: i.out,
         k: p.k,
         kernel: p.kernel,
         topo: p.topo,
         drop_kth: p.drop_kth,
         reference: p.reference,
-        exposure,
+        exposure: i.exposure,
         label: p.label,
         boundary: p.boundary,
         gather_cache: p.gather_cache,
@@ -283,19 +277,16 @@ fn run(cmd: Cmd) -> Result<(), String> {
             scene,
             method,
             photon,
-            spp,
+            image,
             no_caustics,
-            threads,
-            out,
-            exposure,
         } => match method_of(&scene, method)? {
             (m, _) if m == "path" => render::path(render::RenderArgs {
                 scene,
-                spp,
+                spp: image.spp,
                 no_caustics,
-                threads,
-                out,
-                exposure,
+                threads: image.threads,
+                out: image.out,
+                exposure: image.exposure,
             }),
             (m, rays) => {
                 let method = photon_method(&m, photon.gather_rays.unwrap_or(rays))
@@ -306,14 +297,11 @@ fn run(cmd: Cmd) -> Result<(), String> {
                     &trace::TraceArgs {
                         photons: photon.photons,
                         cache: photon.cache.clone(),
-                        threads,
+                        threads: image.threads,
                         force: false,
                     },
                 )?;
-                let e = estimate::estimate(
-                    &s,
-                    &estimate_args(method, photon, spp, threads, out, exposure),
-                )?;
+                let e = estimate::estimate(&s, &estimate_args(method, photon, image))?;
                 println!(
                     "pipeline: trace {} ({:.2} s) + estimate {:.2} s",
                     if t.reused { "reused" } else { "traced" },
@@ -327,10 +315,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
             scene,
             method,
             photon,
-            spp,
-            threads,
-            out,
-            exposure,
+            image,
         } => {
             if method.as_deref() == Some("path") {
                 return Err(
@@ -347,8 +332,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
             };
             let m = photon_method(&m, photon.gather_rays.unwrap_or(rays))?;
             let s = scene::Scene::load(&scene).map_err(|e| e.to_string())?;
-            estimate::estimate(&s, &estimate_args(m, photon, spp, threads, out, exposure))
-                .map(|_| ())
+            estimate::estimate(&s, &estimate_args(m, photon, image)).map(|_| ())
         }
         Cmd::Compare { a, b, mask } => render::compare(&a, &b, mask),
         Cmd::BenchPhotons {
