@@ -1,31 +1,38 @@
 //! Hand-rolled argument parsing: xtask keeps no dependencies so it compiles in seconds.
 
 pub const HELP: &str = "\
-cargo xtask <command>
+cargo xtask <command>   (every command builds the release `photonflow` binary and runs it;
+                         `photonflow <command> --help` lists all options)
 
+  render SCENE [--method path|global-direct|final-gather] [--spp N] [--threads N] [--out DIR]
+                      render with a progress bar; writes image.exr, image.png, layers/, image.json.
+                      path: the path-traced reference (--no-caustics leaves out L S+ D light);
+                      the photon methods chain trace (or reuse the cache) -> estimate -> composite;
+                      without --method: the scene's render.method (default final-gather)
+  trace SCENE [--photons N] [--cache DIR] [--threads N] [--force]
+                      trace the photon sets the scene's effects plan asks for into the cache,
+                      or reuse them when the scene and parameters are unchanged
+  estimate SCENE [--method global-direct|final-gather] [--k N] [--kernel K] [--topo EPS]
+                 [--boundary] [--drop-kth] [--reference EXR]
+                      estimate from the cached photon sets only (never traces)
+  worksheet [--photons N] [--k N] [--topo EPS] [--reference-spp N]
+                      worksheet 7's images (box kernel, Silverman, + topological test,
+                      + boundary correction) with errors against a path-traced reference,
+                      summarised in out/worksheet/README.md
+  compare A.exr B.exr [--mask x0,y0,x1,y1]
+                      RMSE, relative MSE and mean absolute error of A against reference B
+  info SCENE          load a scene and print what it holds
   bench rays [SCENE] [--runs N] [--compare]
                       single-thread rays/s: 1M coherent camera rays and 1M incoherent rays
                       (default scene: scenes/cornell-spheres/tessellated.toml);
                       --compare also measures the binary BVH (Bvh2) next to CwBvh
-  render SCENE --method path [--spp N] [--no-caustics] [--threads N] [--out DIR]
-                      render with a progress bar; writes image.exr, image.png, layers/, image.json
-  compare A.exr B.exr [--mask x0,y0,x1,y1]
-                      RMSE, relative MSE and mean absolute error of A against reference B
-  trace SCENE [--photons N] [--cache DIR] [--threads N] [--force]
-                      trace the photon sets the scene's effects plan asks for into the cache,
-                      or reuse them when the scene and parameters are unchanged
   bench photons [SCENE] [--photons N] [--runs N]
                       photon paths/s on 1 and 2 threads (tracing alone and into photon files)
   bench store [--photons N]
                       write/read GB/s of a 10M-photon file; plain records against bincode
   bench knn [--photons N] [--queries N]
-                      k-NN queries/s for k = 50, 250, 1000 per index (kd-tree, kiddo, brute)
-  estimate SCENE --method global-direct|final-gather [--k N] [--kernel K] [--topo EPS] [--drop-kth]
-                      estimate from the cached photon sets only (never traces)
-  worksheet [--photons N] [--k N] [--topo EPS] [--reference-spp N]
-                      worksheet 7's images (box kernel, Silverman, + topological test) with
-                      errors against a path-traced reference, summarised in out/worksheet/README.md
-  info SCENE          load a scene and print what it holds
+                      k-NN queries/s for k = 50, 250, 1000 per index (kd-tree, kiddo, brute),
+                      and pixel-order irradiance queries with radius hints
   gen-scenes          rewrite the generated OBJ/MTL files under scenes/
 ";
 
