@@ -195,6 +195,29 @@ pub fn sphere_dn(dx: Vec3, radius: f32) -> Vec3 {
     dx / radius
 }
 
+/// Derivative of a smooth-shaded triangle's interpolated normal `n = normalize(Σ b_i n_i)`
+/// (Igehy 1999 §3.2.2; algorithms.md §3.3) for a positional derivative `dx` in the triangle's
+/// plane (after [`transfer`]): `dx = ∂b_1 e_1 + ∂b_2 e_2` with `e_k = p_k - p_0` (solved by
+/// the 2×2 Gram system), `∂N = ∂b_1 (n_1 - n_0) + ∂b_2 (n_2 - n_0)`,
+/// `∂n = (I - n nᵀ) ∂N / |N|`. `b` are the hit's barycentrics. Negate the result when the
+/// normal used is `-n`.
+pub fn mesh_dn(dx: Vec3, p: [Vec3; 3], ns: [Vec3; 3], b: [f32; 3]) -> Vec3 {
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    let (a11, a12, a22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let det = a11 * a22 - a12 * a12;
+    if det.abs() <= f32::MIN_POSITIVE {
+        return Vec3::ZERO;
+    }
+    let (r1, r2) = (dx.dot(e1), dx.dot(e2));
+    let db1 = (a22 * r1 - a12 * r2) / det;
+    let db2 = (a11 * r2 - a12 * r1) / det;
+    let big_n = b[0] * ns[0] + b[1] * ns[1] + b[2] * ns[2];
+    let len = big_n.length();
+    let n = big_n / len;
+    let dbig_n = db1 * (ns[1] - ns[0]) + db2 * (ns[2] - ns[0]);
+    (dbig_n - n * n.dot(dbig_n)) / len
+}
+
 #[cfg(test)]
 #[path = "diff_tests.rs"]
 mod tests;

@@ -24,6 +24,23 @@ enum Step {
     Enter { c: DVec3, r: f64, ior: f64 },
     /// Hit the sphere from inside (far root) and refract out.
     Exit { c: DVec3, r: f64, ior: f64 },
+    /// Hit the plane of a smooth-shaded triangle and reflect about its interpolated normal.
+    Smooth { p: [DVec3; 3], n: [DVec3; 3] },
+}
+
+/// Barycentrics of `x` in the plane of triangle `p`, and the interpolated unit normal.
+fn smooth_normal(x: DVec3, p: [DVec3; 3], n: [DVec3; 3]) -> ([f64; 3], DVec3) {
+    let (e1, e2, q) = (p[1] - p[0], p[2] - p[0], x - p[0]);
+    let (a11, a12, a22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let det = a11 * a22 - a12 * a12;
+    let b1 = (a22 * q.dot(e1) - a12 * q.dot(e2)) / det;
+    let b2 = (a11 * q.dot(e2) - a12 * q.dot(e1)) / det;
+    let b = [1.0 - b1 - b2, b1, b2];
+    (b, (b[0] * n[0] + b[1] * n[1] + b[2] * n[2]).normalize())
+}
+
+fn tri_normal(p: [DVec3; 3]) -> DVec3 {
+    (p[1] - p[0]).cross(p[2] - p[0]).normalize()
 }
 
 fn plane_t(o: DVec3, d: DVec3, p: DVec3, n: DVec3) -> f64 {
@@ -71,6 +88,10 @@ fn trace64(steps: &[Step], mut o: DVec3, mut d: DVec3) -> Option<Vec<(DVec3, DVe
                 o += sphere_t(o, d, c, r, true)? * d;
                 d = refract64(d, -(o - c) / r, ior)?;
             }
+            Step::Smooth { p, n } => {
+                o += plane_t(o, d, p[0], tri_normal(p)) * d;
+                d = reflect64(d, smooth_normal(o, p, n).1);
+            }
         }
         out.push((o, d));
     }
@@ -106,6 +127,15 @@ fn trace_diff(steps: &[Step], rd: RayDiff) -> Vec<RayDiff> {
                 let x = transfer(&rd, t as f32, n);
                 let (du, dv) = (sphere_dn(x.dodu, -r as f32), sphere_dn(x.dodv, -r as f32));
                 refract_diff(&x, n, du, dv, ior as f32).unwrap()
+            }
+            Step::Smooth { p, n } => {
+                let ng = tri_normal(p);
+                let x = transfer(&rd, plane_t(o, d, p[0], ng) as f32, ng.as_vec3());
+                let (b, ns) = smooth_normal(x.o.as_dvec3(), p, n);
+                let (pf, nf) = (p.map(|v| v.as_vec3()), n.map(|v| v.as_vec3()));
+                let bf = b.map(|v| v as f32);
+                let (du, dv) = (mesh_dn(x.dodu, pf, nf, bf), mesh_dn(x.dodv, pf, nf, bf));
+                reflect_diff(&x, ns.as_vec3(), du, dv)
             }
         };
         out.push(rd);
@@ -250,6 +280,32 @@ fn refraction_through_a_glass_sphere_matches_finite_differences() {
         worst = worst.max(max_fd_error(&steps, random_diff(&mut rng, o, d)));
     }
     eprintln!("glass sphere: max relative error {worst:.3e}");
+    assert!(worst < 1e-2, "max relative error {worst}");
+}
+
+#[test]
+fn reflection_off_a_smooth_shaded_triangle_matches_finite_differences() {
+    let mut rng = Rng::new(15);
+    let mut worst = 0.0f64;
+    for _ in 0..200 {
+        // A triangle in z = 0 with vertex normals tilted up to ~30° from +z.
+        let p = [
+            DVec3::new(-1.0, -1.0, 0.0),
+            DVec3::new(1.5, -0.8, 0.0),
+            DVec3::new(-0.2, 1.4, 0.0),
+        ];
+        let n =
+            [0; 3].map(|_| (DVec3::Z + 0.6 * unit(&mut rng) * rng.uniform() as f64).normalize());
+        let smooth = Step::Smooth { p, n };
+        // From above, aimed at the triangle's middle.
+        let target = (p[0] + p[1] + p[2]) / 3.0 + 0.3 * unit(&mut rng) * DVec3::new(1.0, 1.0, 0.0);
+        let o = target + 3.0 * (DVec3::Z + 0.8 * unit(&mut rng)).normalize();
+        let d = (target - o).normalize();
+        let (x, w) = trace64(&[smooth], o, d).unwrap()[0];
+        let steps = [smooth, plane_after(&mut rng, x, w, 2.0)];
+        worst = worst.max(max_fd_error(&steps, random_diff(&mut rng, o, d)));
+    }
+    eprintln!("smooth triangle reflection: max relative error {worst:.3e}");
     assert!(worst < 1e-2, "max relative error {worst}");
 }
 

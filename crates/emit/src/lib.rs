@@ -34,7 +34,7 @@ mod params;
 mod plan;
 mod trace;
 
-pub use diff::{RayDiff, emit_diff, reflect_diff, refract_diff, sphere_dn, transfer};
+pub use diff::{RayDiff, emit_diff, mesh_dn, reflect_diff, refract_diff, sphere_dn, transfer};
 pub use light::{Emitted, LightSampler};
 pub use params::EmitParams;
 pub use plan::{Plan, PlanError};
