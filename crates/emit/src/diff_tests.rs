@@ -165,7 +165,7 @@ fn max_fd_error(steps: &[Step], rd: RayDiff) -> f64 {
                 (a.dodv, a.dddv)
             };
             worst = worst.max(rel(fx, ax));
-            // A transfer leaves the direction alone; compare it where it changed or is nonzero.
+            // Directions too (a transfer must leave them unchanged).
             worst = worst.max(rel(fd, ad));
         }
     }
