@@ -10,6 +10,8 @@ use scene::Scene;
 #[derive(Clone, Debug)]
 struct Light {
     vertices: [Vec3; 3],
+    /// The scene's area of the triangle.
+    area: f32,
     frame: Frame,
     /// `π A Le` in f64 from the scene's f32 area and radiance: no f32 rounding of the product,
     /// so the flux identity `Φ_i / (p_i N) = Φ_total / N` holds to f64 precision.
@@ -50,6 +52,7 @@ impl LightSampler {
             .iter()
             .map(|l| Light {
                 vertices: mesh.vertices(l.triangle as usize),
+                area: l.area,
                 frame: Frame::from_z(l.normal),
                 power: std::f64::consts::PI * l.area as f64 * l.le.as_dvec3(),
                 pmf: 0.0,
@@ -93,6 +96,21 @@ impl LightSampler {
     /// Power of light `i`, `π A Le`.
     pub fn power(&self, i: usize) -> DVec3 {
         self.lights[i].power
+    }
+
+    /// Vertices of light triangle `i`.
+    pub fn vertices(&self, i: usize) -> [Vec3; 3] {
+        self.lights[i].vertices
+    }
+
+    /// Area of light triangle `i` (the scene's value).
+    pub fn area(&self, i: usize) -> f32 {
+        self.lights[i].area
+    }
+
+    /// Frame of light `i`: `n` is the emitting side's normal, `s` and `t` its tangents.
+    pub fn frame(&self, i: usize) -> Frame {
+        self.lights[i].frame
     }
 
     /// Flux of a photon from light `i` when `photons` paths are emitted in all: the
