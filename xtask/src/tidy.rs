@@ -12,7 +12,7 @@
 const ALLOWED: &[(&str, &[&str])] = &[
     ("math", &[]),
     ("geom", &["math"]),
-    ("scene", &["geom"]),
+    ("scene", &["math", "geom"]),
     ("bsdf", &["math"]),
     ("film", &[]),
     ("store", &["math"]),

@@ -3,16 +3,13 @@
 
 use geom::{Prim, SurfacePoint};
 use glam::Vec3;
-use math::Distribution1D;
-use math::warp::sample_uniform_triangle;
-use scene::Scene;
+use scene::{LightChooser, LightPoint, Scene};
 
 /// Marks a triangle that is not a light in [`LightSampler`]'s lookup table.
 const NOT_A_LIGHT: u32 = u32::MAX;
 
 #[derive(Clone, Copy, Debug)]
 struct Emitter {
-    vertices: [Vec3; 3],
     normal: Vec3,
     area: f32,
     le: Vec3,
@@ -36,11 +33,12 @@ pub struct LightSample {
 }
 
 /// Chooses an emissive triangle with probability proportional to its power (sum of RGB, in
-/// f64) and a uniform point on it.
+/// f64) and a uniform point on it (`scene::LightChooser`, shared with photon emission), and
+/// converts the density to solid angle at the receiver.
 #[derive(Clone, Debug)]
 pub struct LightSampler {
     emitters: Vec<Emitter>,
-    distribution: Distribution1D,
+    chooser: LightChooser,
     /// Light index of each mesh triangle, or `NOT_A_LIGHT`.
     light_of_triangle: Vec<u32>,
 }
@@ -57,21 +55,16 @@ impl LightSampler {
             .map(|(i, l)| {
                 light_of_triangle[l.triangle as usize] = i as u32;
                 Emitter {
-                    vertices: mesh.vertices(l.triangle as usize),
                     normal: l.normal,
                     area: l.area,
                     le: l.le,
                 }
             })
             .collect();
-        let weights: Vec<f64> = scene
-            .lights
-            .iter()
-            .map(|l| l.power.as_dvec3().element_sum())
-            .collect();
         LightSampler {
             emitters,
-            distribution: Distribution1D::new(&weights),
+            // Scene loading guarantees a light with positive, finite power.
+            chooser: LightChooser::new(scene).expect("a loaded scene has a light"),
             light_of_triangle,
         }
     }
@@ -112,12 +105,13 @@ impl LightSampler {
     /// `None` when the point cannot send light to `from` (it sees the light's back or lies in
     /// its plane), which NEE counts as a zero contribution.
     pub fn sample(&self, from: Vec3, u_pick: f32, u: [f32; 2]) -> Option<LightSample> {
-        let (i, pmf, _) = self.distribution.sample(u_pick);
+        let LightPoint {
+            light: i,
+            pmf,
+            point,
+        } = self.chooser.sample(u_pick, u);
         let e = &self.emitters[i];
-        let b = sample_uniform_triangle(u);
-        let [p0, p1, p2] = e.vertices;
-        let p = b.x * p0 + b.y * p1 + b.z * p2;
-        let p_err = SurfacePoint::barycentric_error([b.x, b.y, b.z], e.vertices);
+        let p = point.p;
         let to = p - from;
         let dist2 = to.length_squared();
         if dist2 <= 0.0 || !dist2.is_finite() {
@@ -129,17 +123,13 @@ impl LightSampler {
         if cos_light <= 0.0 || cos_light.is_nan() {
             return None;
         }
-        let pdf = pmf / e.area * dist2 / cos_light;
+        let pdf = pmf as f32 / e.area * dist2 / cos_light;
         if !(pdf.is_finite() && pdf > 0.0) {
             return None;
         }
         Some(LightSample {
             light: i,
-            point: SurfacePoint {
-                p,
-                p_err,
-                n: e.normal,
-            },
+            point,
             le: e.le,
             wi,
             dist,
@@ -160,7 +150,7 @@ impl LightSampler {
         if cos_light <= 0.0 || cos_light.is_nan() {
             return 0.0;
         }
-        self.distribution.pmf(light) / e.area * dist2 / cos_light
+        self.chooser.pmf(light) as f32 / e.area * dist2 / cos_light
     }
 
     /// [`LightSampler::pdf`] for a BSDF-sampled hit, 0 if the hit is not on a light.

@@ -12,6 +12,7 @@
 mod camera;
 mod error;
 mod file;
+mod lights;
 mod load;
 mod material;
 
@@ -21,6 +22,7 @@ pub use file::{
     CameraDesc, EmissionSource, MaterialDesc, MeshDesc, NormalMode, RenderSettings, SceneFile,
     SphereDesc,
 };
+pub use lights::{LightChooser, LightPoint};
 pub use load::{AreaLight, Scene, fnv1a64};
 pub use material::Material;
 
