@@ -594,9 +594,15 @@ impl Brute {
         out: &mut Vec<Neighbor>,
     ) {
         self.knn(q, k, r_max, out);
-        out.sort_unstable_by_key(|n| n.index);
-        hint.update(q, k, r_max, out);
+        in_index_order(q, k, r_max, hint, out);
     }
+}
+
+/// The hinted answer of a back-end without a radius-first search: its exact k-NN, put in
+/// index order (the order `knn_hinted` promises), with the hint updated.
+fn in_index_order(q: Vec3, k: usize, r_max: f32, hint: &mut KnnHint, out: &mut [Neighbor]) {
+    out.sort_unstable_by_key(|n| n.index);
+    hint.update(q, k, r_max, out);
 }
 
 /// kiddo 5's `ImmutableKdTree` (bucket 32, u32 items). kiddo orders results by distance
@@ -659,8 +665,7 @@ impl Kiddo {
         out: &mut Vec<Neighbor>,
     ) {
         self.knn(q, k, r_max, out);
-        out.sort_unstable_by_key(|n| n.index);
-        hint.update(q, k, r_max, out);
+        in_index_order(q, k, r_max, hint, out);
     }
 }
 

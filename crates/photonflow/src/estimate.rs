@@ -304,7 +304,8 @@ pub fn estimate(scene: &Scene, a: &EstimateArgs) -> Result<EstimateOutput, Strin
     if let Some(why) = incomplete {
         return Err(format!("{}: {why}", scene.path.display()));
     }
-    if a.boundary && params(scene, a)?.0.topo.is_none() {
+    let (gp, cp) = params(scene, a)?;
+    if a.boundary && gp.topo.is_none() {
         return Err(format!(
             "{}: --boundary needs the topological test (--topo EPS): the correction divides by \
              the share of the disc on this surface, so photons from other surfaces must be \
@@ -335,7 +336,6 @@ pub fn estimate(scene: &Scene, a: &EstimateArgs) -> Result<EstimateOutput, Strin
         }
     }
     let t_load = t0.elapsed().as_secs_f64();
-    let (gp, cp) = params(scene, a)?;
     let mut maps = Maps {
         global,
         caustic,

@@ -332,7 +332,7 @@ impl<'a> Builder<'a> {
             return Err(self.err("emissive spheres are not supported: lights are triangles"));
         }
 
-        let content_hash = self.hash.finish();
+        // The hashes need the whole scene text: `Scene::from_toml` sets them.
         Ok(Scene {
             path: self.scene_path.to_path_buf(),
             file,
@@ -342,7 +342,7 @@ impl<'a> Builder<'a> {
             emission: self.emission,
             lights,
             camera,
-            content_hash,
+            content_hash: 0,
             photon_hash: 0,
             image_hash: 0,
         })
