@@ -3,8 +3,9 @@
 //! closed box against its light power.
 
 use bsdf::TransportMode;
-use emit::{EmitParams, Plan, SPHERE_BIT, chunks, trace_parallel, trace_range};
-use eye::{LightSampler, Part, PathOptions, PathTracer, bsdf_of};
+use emit::{EmitParams, Plan, chunks, trace_parallel, trace_range};
+use scene::SPHERE_BIT;
+use eye::{Part, PathOptions, PathTracer};
 use geom::{Hit, Prim, Ray};
 use glam::{DVec3, Vec2, Vec3};
 use math::warp::{sample_cosine_hemisphere, sample_uniform_disk_concentric};
@@ -151,8 +152,7 @@ fn eye_flux(scene: &Scene, samples: u64) -> (DVec3, DVec3) {
 /// direction (`E = π E[L]`) followed through specular surfaces only; light reached after one
 /// or more specular bounces is `L S+ D` light at x, anything else ends the path.
 fn chain_flux(scene: &Scene, samples: u64) -> (DVec3, DVec3) {
-    let bsdfs: Vec<_> = scene.materials.iter().map(bsdf_of).collect();
-    let lights = LightSampler::new(scene);
+    let lights = &scene.light_table;
     let area = PI * (RADIUS as f64).powi(2);
     let mut e = Mean::default();
     for i in 0..samples {
@@ -176,7 +176,9 @@ fn chain_flux(scene: &Scene, samples: u64) -> (DVec3, DVec3) {
                 }
                 break;
             }
-            let bsdf = bsdfs[hit.material as usize];
+            let Some(bsdf) = scene.bsdf(hit.material) else {
+                break;
+            };
             if !bsdf.is_delta() || specular + 1 == MAX_DEPTH {
                 break;
             }

@@ -2,9 +2,9 @@
 //! emission parameters `(u, v)`, initialised at an area light and propagated through
 //! transfer, reflection and refraction (Igehy 1999, "Tracing ray differentials"; Schjøth et
 //! al. 2007, "Photon differentials"; Frisvad et al. 2014, "Photon differential splatting for
-//! rendering caustics"). Recipe: `shared/reference/algorithms.md` §3.
+//! rendering caustics"). Each function below states the formulas it implements.
 //!
-//! Representation (§3.1): one pair `(∂o/∂u, ∂d/∂u)` and one pair `(∂o/∂v, ∂d/∂v)`, with the
+//! Representation: one pair `(∂o/∂u, ∂d/∂u)` and one pair `(∂o/∂v, ∂d/∂v)`, with the
 //! positional and the angular emission spread both assigned to the same `u` and `v` (the
 //! merged form of Frisvad et al. 2014). `d` is unit, so `∂d/∂u ⊥ d` at emission and after
 //! every interaction below (to first order).
@@ -20,18 +20,18 @@
 //!
 //! Pure functions of their arguments; f32 per element (the finite-difference tests use f64).
 
-use crate::{Emitted, LightSampler};
+use scene::{Emitted, LightTable};
 use glam::Vec3;
 use math::Frame;
 
-/// Smallest `cos θ` about the light normal used for the angular footprint (§3.2): grazing
-/// emission would give an unbounded solid-angle cell.
+/// Smallest `cos θ` about the light normal used for the angular footprint ([`emit_diff`]):
+/// grazing emission would give an unbounded solid-angle cell.
 pub const MIN_EMIT_COS: f32 = 0.05;
 
-/// Smallest `|d·n|` in the transfer denominator (§3.5: grazing hits blow differentials up).
+/// Smallest `|d·n|` in the transfer denominator (grazing hits blow differentials up).
 pub const MIN_TRANSFER_COS: f32 = 1e-3;
 
-/// Smallest `|T·n|` in the refraction derivative (§3.5: near-critical refraction).
+/// Smallest `|T·n|` in the refraction derivative (near-critical refraction).
 pub const MIN_REFRACT_COS: f32 = 1e-3;
 
 /// A ray with first-order derivatives of origin and (unit) direction with respect to two
@@ -59,8 +59,8 @@ impl RayDiff {
     }
 }
 
-/// Emit one photon with [`LightSampler::sample`] and attach its differentials (algorithms.md
-/// §3.2): the photon owns a cell of measure `1 / (N pdf)` of each sampled domain.
+/// Emit one photon with [`LightTable::emit`] and attach its differentials: the photon
+/// owns a cell of measure `1 / (N pdf)` of each sampled domain.
 ///
 /// - Position: the point has area density `p_i / A_i` (light `i` chosen with probability
 ///   `p_i`, then uniform on its area `A_i`), so the cell is `A_i / (p_i N)` and
@@ -75,14 +75,14 @@ impl RayDiff {
 ///
 /// The differential's origin and direction are the emitted ray's.
 pub fn emit_diff(
-    sampler: &LightSampler,
+    sampler: &LightTable,
     u_light: f32,
     u_pos: [f32; 2],
     u_dir: [f32; 2],
     photons: u64,
     scale: f32,
 ) -> (Emitted, RayDiff) {
-    let e = sampler.sample(u_light, u_pos, u_dir, photons);
+    let e = sampler.emit(u_light, u_pos, u_dir, photons);
     let frame = sampler.frame(e.light);
     let n = photons.max(1) as f64;
     let cell = sampler.area(e.light) as f64 / (sampler.pmf(e.light) * n);
@@ -155,8 +155,8 @@ pub fn reflect_diff(rd: &RayDiff, n: Vec3, dndu: Vec3, dndv: Vec3) -> RayDiff {
 }
 
 /// Refraction at the ray's origin (call after [`transfer`]) with `eta = n_incident /
-/// n_transmitted` (Igehy 1999 §3.1.3; algorithms.md §3.3). With `n` facing the incoming side
-/// (`d·n < 0`; otherwise `n` and its derivatives are flipped):
+/// n_transmitted` (Igehy 1999 §3.1.3). With `n` facing the incoming side (`d·n < 0`;
+/// otherwise `n` and its derivatives are flipped):
 /// `T = η d - μ n`, `T·n = -sqrt(1 - η² (1 - (d·n)²))`, `μ = η (d·n) - T·n`,
 /// `∂(d·n) = ∂d·n + d·∂n`, `∂μ = (η - η² (d·n)/(T·n)) ∂(d·n)`, `∂T = η ∂d - (μ ∂n + ∂μ n)`.
 /// `|T·n|` in `∂μ` is clamped by [`MIN_REFRACT_COS`]. Total internal reflection → `None`
@@ -188,16 +188,16 @@ pub fn refract_diff(rd: &RayDiff, n: Vec3, dndu: Vec3, dndv: Vec3, eta: f32) -> 
 }
 
 /// Derivative of a sphere's unit normal for a positional derivative `dx` in the tangent
-/// plane (after [`transfer`]): `n = (x - c)/R ⇒ ∂n = ∂x/R` (algorithms.md §3.3). Pass the
-/// radius negated when the normal used is the inward one, `n = -(x - c)/R`, e.g. for a
-/// photon leaving a glass sphere.
+/// plane (after [`transfer`]): `n = (x - c)/R ⇒ ∂n = ∂x/R`. Pass the radius negated when
+/// the normal used is the inward one, `n = -(x - c)/R`, e.g. for a photon leaving a glass
+/// sphere.
 pub fn sphere_dn(dx: Vec3, radius: f32) -> Vec3 {
     dx / radius
 }
 
 /// Derivative of a smooth-shaded triangle's interpolated normal `n = normalize(Σ b_i n_i)`
-/// (Igehy 1999 §3.2.2; algorithms.md §3.3) for a positional derivative `dx` in the triangle's
-/// plane (after [`transfer`]): `dx = ∂b_1 e_1 + ∂b_2 e_2` with `e_k = p_k - p_0` (solved by
+/// (Igehy 1999 §3.2.2) for a positional derivative `dx` in the triangle's plane (after
+/// [`transfer`]): `dx = ∂b_1 e_1 + ∂b_2 e_2` with `e_k = p_k - p_0` (solved by
 /// the 2×2 Gram system), `∂N = ∂b_1 (n_1 - n_0) + ∂b_2 (n_2 - n_0)`,
 /// `∂n = (I - n nᵀ) ∂N / |N|`. `b` are the hit's barycentrics. Negate the result when the
 /// normal used is `-n`.

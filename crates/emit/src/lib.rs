@@ -4,9 +4,9 @@
 //! Key decision: **photon `i` is a pure function of `(scene seed, i)`**. Its random numbers
 //! come from [`math::Rng::for_index`] and nothing it does depends on any other photon, so
 //! [`trace_range`] over consecutive ranges, concatenated, equals one big range bit for bit,
-//! whatever the thread count and chunk size (style anchor A1.8, pbrt-v4's SPPM photon
-//! indexing). Workers therefore need no shared state and no ordering beyond "concatenate
-//! chunks in index order".
+//! whatever the thread count and chunk size (pbrt-v4's habit in SPPM: a photon's samples are
+//! indexed by the photon's number). Workers therefore need no shared state and no ordering
+//! beyond "concatenate chunks in index order".
 //!
 //! Second decision: an **effects plan** ([`Plan`]) is made from the scene before any photon
 //! is traced. A set no surface can produce is not traced at all (no specular surface → no
@@ -14,7 +14,7 @@
 //! longer add to a planned set, so a caustic-only run ends every path at its first diffuse hit.
 //!
 //! Estimators normalise by the number of photon *paths emitted*, never by the number stored:
-//! [`Traced::emitted`] carries it next to the photons (style anchor C).
+//! [`Traced::emitted`] carries it next to the photons.
 //!
 //! Tracing rules (the whole contract, see [`trace_range`]):
 //! - emission: a light triangle chosen with probability ∝ its power (summed over RGB), a point
@@ -29,16 +29,14 @@
 //! - black surfaces absorb; a path ends on escape or after [`EmitParams::max_depth`] hits.
 
 pub mod diff;
-mod light;
 mod params;
 mod plan;
 mod trace;
 
 pub use diff::{RayDiff, emit_diff, mesh_dn, reflect_diff, refract_diff, sphere_dn, transfer};
-pub use light::{Emitted, LightSampler};
 pub use params::EmitParams;
 pub use plan::{Plan, PlanError};
-pub use trace::{EMIT_STREAM, SPHERE_BIT, Traced, chunks, surface_id, trace_parallel, trace_range};
+pub use trace::{EMIT_STREAM, Traced, chunks, trace_parallel, trace_range};
 
 #[cfg(test)]
 mod tests;

@@ -1,7 +1,6 @@
 //! The effects plan: which photon sets a run needs, decided from the scene before tracing.
 
-use crate::{EmitParams, LightSampler};
-use geom::Prim;
+use crate::EmitParams;
 use scene::{Material, Scene};
 use serde::Serialize;
 use std::fmt;
@@ -27,8 +26,6 @@ pub struct Plan {
 /// A run that cannot be planned.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum PlanError {
-    /// No emitting triangle, or lights whose total power is zero: no photon can be emitted.
-    NoLight { scene: String },
     /// `photons = 0`: the flux `Φ / N` is undefined.
     NoPhotons,
 }
@@ -36,11 +33,6 @@ pub enum PlanError {
 impl fmt::Display for PlanError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            PlanError::NoLight { scene } => write!(
-                f,
-                "scene `{scene}` has no light with positive power: no photon can be emitted \
-                 (give some triangle's material an emission)"
-            ),
             PlanError::NoPhotons => write!(f, "photons = 0: emit at least one photon path"),
         }
     }
@@ -53,17 +45,11 @@ impl Plan {
     /// Specular: mirror, metal or dielectric. Diffuse: Lambertian with a non-zero albedo (a
     /// black surface reflects nothing, so photons stored there could never be seen).
     /// - no diffuse surface → no global set, and no caustic set (nowhere to store it);
-    /// - no specular surface → no caustic set (no path can be L S+ D);
-    /// - no light → [`PlanError::NoLight`] (scene loading refuses such scenes today; the plan
-    ///   does not rely on it).
+    /// - no specular surface → no caustic set (no path can be L S+ D).
+    ///
+    /// A loaded scene always has a light with positive power (its `light_table`).
     pub fn for_scene(scene: &Scene, params: &EmitParams) -> Result<Plan, PlanError> {
-        // The sampler decides what counts as a light, so plan and tracer cannot disagree.
-        let Some(lights) = LightSampler::new(scene) else {
-            return Err(PlanError::NoLight {
-                scene: scene.file.name.clone(),
-            });
-        };
-        let power = lights.total_power();
+        let power = scene.light_table.total_power();
         if params.photons == 0 {
             return Err(PlanError::NoPhotons);
         }
@@ -76,18 +62,14 @@ impl Plan {
         for s in geometry.spheres() {
             used[s.material as usize] = true;
         }
-        let names = |pred: &dyn Fn(&Material) -> bool| -> Vec<&str> {
-            scene
-                .materials
-                .iter()
-                .zip(&scene.material_names)
-                .zip(&used)
-                .filter(|((m, _), u)| **u && pred(m))
-                .map(|((_, n), _)| n.as_str())
+        let names = |pred: &dyn Fn(u32, &Material) -> bool| -> Vec<&str> {
+            (0..scene.materials.len())
+                .filter(|&m| used[m] && pred(m as u32, &scene.materials[m]))
+                .map(|m| scene.material_names[m].as_str())
                 .collect()
         };
-        let diffuse = names(&is_diffuse);
-        let specular = names(&Material::is_specular);
+        let diffuse = names(&|m, _| scene.is_diffuse(m));
+        let specular = names(&|_, m| m.is_specular());
 
         let mut reasons = Vec::new();
         let global = params.global && !diffuse.is_empty();
@@ -135,19 +117,6 @@ impl Plan {
     /// True when no photon set is traced at all.
     pub fn is_empty(&self) -> bool {
         !self.global && !self.caustic
-    }
-}
-
-/// A material photons are stored on: Lambertian and not black.
-pub(crate) fn is_diffuse(m: &Material) -> bool {
-    matches!(m, Material::Lambertian { albedo } if albedo.max_element() > 0.0)
-}
-
-/// The surface id a photon records: the triangle id, or the sphere id with the top bit set.
-pub(crate) fn prim_id(prim: Prim) -> u32 {
-    match prim {
-        Prim::Triangle(i) => i,
-        Prim::Sphere(i) => i | crate::SPHERE_BIT,
     }
 }
 

@@ -3,14 +3,14 @@
 //! over any split, and the emission distribution against its pdf.
 
 use crate::{
-    EMIT_STREAM, EmitParams, LightSampler, Plan, PlanError, SPHERE_BIT, Traced, chunks,
+    EMIT_STREAM, EmitParams, Plan, PlanError, Traced, chunks,
     trace_parallel, trace_range,
 };
 use glam::DVec3;
 use math::chi2::{chi2_test, pearson};
 use math::warp::cosine_hemisphere_pdf;
 use math::{Frame, Rng};
-use scene::{Material, Scene};
+use scene::{Material, SPHERE_BIT, Scene};
 use std::path::{Path, PathBuf};
 
 fn scenes_dir() -> PathBuf {
@@ -169,23 +169,11 @@ fn scenes_without_diffuse_surfaces_trace_nothing() {
 }
 
 #[test]
-fn plan_refuses_a_scene_without_light_and_zero_photons() {
-    let mut scene = load("corner/corner.toml");
-    assert_eq!(
-        Plan::for_scene(&scene, &params(0)),
-        Err(PlanError::NoPhotons)
-    );
-    // Loading refuses lightless scenes; the plan does not rely on it.
-    scene.lights.clear();
-    let err = Plan::for_scene(&scene, &EmitParams::default()).unwrap_err();
-    assert_eq!(
-        err,
-        PlanError::NoLight {
-            scene: "corner".into()
-        }
-    );
-    assert!(err.to_string().contains("no light"), "{err}");
-    assert!(LightSampler::new(&scene).is_none());
+fn plan_refuses_zero_photons() {
+    let scene = load("corner/corner.toml");
+    let err = Plan::for_scene(&scene, &params(0)).unwrap_err();
+    assert_eq!(err, PlanError::NoPhotons);
+    assert!(err.to_string().contains("photons = 0"), "{err}");
 }
 
 #[test]
@@ -226,7 +214,7 @@ fn photon_flux_is_total_power_over_paths_emitted() {
         ("furnace", furnace([0.5; 3])),
         ("corner", load("corner/corner.toml")),
     ] {
-        let lights = LightSampler::new(&scene).unwrap();
+        let lights = scene.light_table.clone();
         let n = 123_457;
         let expected = lights.total_power() / n as f64;
         for i in 0..lights.len() {
@@ -240,7 +228,7 @@ fn photon_flux_is_total_power_over_paths_emitted() {
         assert!(rel_err(lights.total_power(), scene.light_power().as_dvec3()) < 1e-6);
     }
     // Worksheet numbers (scene-facts.md): Φ = 26.80 (36.8, 31.2, 16.0) = (986.3, 836.2, 428.8).
-    let cornell = LightSampler::new(&load("cornell-spheres/analytic.toml")).unwrap();
+    let cornell = load("cornell-spheres/analytic.toml").light_table;
     let want = DVec3::new(986.3, 836.2, 428.8);
     assert!(
         rel_err(cornell.total_power(), want) < 2e-4,
@@ -253,7 +241,7 @@ fn photon_flux_is_total_power_over_paths_emitted() {
 fn flux_of_differently_coloured_lights_is_unbiased() {
     // Lights of different colours: each photon's flux differs, its expectation does not.
     let scene = two_lights();
-    let lights = LightSampler::new(&scene).unwrap();
+    let lights = scene.light_table.clone();
     assert_eq!(lights.len(), 2 + 12);
     let n = 1000;
     let expected: DVec3 = (0..lights.len())
@@ -271,12 +259,12 @@ fn flux_of_differently_coloured_lights_is_unbiased() {
 #[test]
 fn lights_are_chosen_by_power() {
     let scene = two_lights();
-    let lights = LightSampler::new(&scene).unwrap();
+    let lights = scene.light_table.clone();
     let n = 200_000;
     let mut counts = vec![0.0; lights.len()];
     let mut rng = Rng::new(11);
     for _ in 0..n {
-        let e = lights.sample(rng.uniform(), rng.uniform2(), rng.uniform2(), n);
+        let e = lights.emit(rng.uniform(), rng.uniform2(), rng.uniform2(), n);
         counts[e.light] += 1.0;
     }
     let expected: Vec<f64> = (0..lights.len())
@@ -296,7 +284,7 @@ fn lights_are_chosen_by_power() {
 fn emission_is_cosine_weighted_about_the_light_normal() {
     // The corner scene's light faces down; every direction must follow cos θ / π about it.
     let scene = load("corner/corner.toml");
-    let lights = LightSampler::new(&scene).unwrap();
+    let lights = scene.light_table.clone();
     let frame = Frame::from_z(scene.lights[0].normal);
     assert!(scene.lights.iter().all(|l| l.normal == frame.n));
     chi2_test(
@@ -305,7 +293,7 @@ fn emission_is_cosine_weighted_about_the_light_normal() {
         200_000,
         21,
         |rng| {
-            let e = lights.sample(rng.uniform(), rng.uniform2(), rng.uniform2(), 1);
+            let e = lights.emit(rng.uniform(), rng.uniform2(), rng.uniform2(), 1);
             Some(frame.to_local(e.ray.d))
         },
         |w| cosine_hemisphere_pdf(w) as f64,
@@ -316,11 +304,11 @@ fn emission_is_cosine_weighted_about_the_light_normal() {
 #[test]
 fn photons_leave_from_the_chosen_light_on_its_emitting_side() {
     let scene = load("cornell-spheres/analytic.toml");
-    let lights = LightSampler::new(&scene).unwrap();
+    let lights = scene.light_table.clone();
     let mesh = scene.geometry.mesh();
     let mut rng = Rng::new(5);
     for _ in 0..10_000 {
-        let e = lights.sample(rng.uniform(), rng.uniform2(), rng.uniform2(), 1);
+        let e = lights.emit(rng.uniform(), rng.uniform2(), rng.uniform2(), 1);
         let l = &scene.lights[e.light];
         let [a, b, c] = mesh.vertices(l.triangle as usize);
         // Inside the triangle: the three sub-areas sum to the whole.
@@ -353,7 +341,7 @@ fn first_hits_carry_exactly_the_light_power_in_a_closed_box() {
     let t = trace(&scene, &p);
     // In a closed box every path hits a wall, and every first hit is stored.
     assert_eq!(t.global.len() as u64, p.photons);
-    let power = LightSampler::new(&scene).unwrap().total_power();
+    let power = scene.light_table.clone().total_power();
     let stored = sum_power(&t.global);
     assert!(
         rel_err(stored, power) < 1e-6,
@@ -373,7 +361,7 @@ fn russian_roulette_keeps_the_expected_flux_in_a_closed_box() {
     let scene = furnace(rho.as_vec3().to_array());
     let p = params(40_000);
     let pl = plan(&scene, &p);
-    let power = LightSampler::new(&scene).unwrap().total_power();
+    let power = scene.light_table.clone().total_power();
     let d = p.max_depth as f64;
     let one = DVec3::ONE;
     let expected = power * (one - rho.powf(d)) / (one - rho);
@@ -635,7 +623,7 @@ fn photons_record_their_surface_and_direction_of_travel() {
     }
     // The analytic spheres record their id with the top bit set.
     let cornell = load("cornell-spheres/analytic.toml");
-    let surface = crate::surface_id(geom::Prim::Sphere(1));
+    let surface = scene::surface_id(geom::Prim::Sphere(1));
     assert_eq!(surface, 1 | SPHERE_BIT);
     assert!(matches!(
         material_at(&cornell, surface),

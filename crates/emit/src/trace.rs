@@ -1,27 +1,17 @@
 //! Photon tracing: paths from the lights, stored at diffuse hits.
 
-use crate::plan::{is_diffuse, prim_id};
-use crate::{EmitParams, LightSampler, Plan};
-use bsdf::{Bsdf, Dielectric, Lambertian, Metal, Mirror, TransportMode};
-use geom::Prim;
+use crate::{EmitParams, Plan};
+use bsdf::{Bsdf, Lambertian, TransportMode};
 use glam::Vec3;
 use math::{Frame, Rng};
 use rayon::prelude::*;
-use scene::{Material, Scene};
+use scene::{Scene, sides_agree, surface_id};
 use std::ops::Range;
 use store::Photon;
 
 /// Mixed into the scene seed for photon streams, so photon `i` and the eye pass's sample `i`
 /// never share random numbers ("emitphot" in ASCII).
 pub const EMIT_STREAM: u64 = 0x656d_6974_7068_6f74;
-
-/// Set in [`Photon::surface`] for a sphere id; clear for a triangle id.
-pub const SPHERE_BIT: u32 = 0x8000_0000;
-
-/// The surface id a photon records for a primitive.
-pub fn surface_id(prim: Prim) -> u32 {
-    prim_id(prim)
-}
 
 /// Photons of a range of paths, in path order (and hit order within a path).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -83,16 +73,10 @@ pub fn trace_range(scene: &Scene, params: &EmitParams, plan: &Plan, range: Range
     if plan.is_empty() || params.max_depth == 0 {
         return out;
     }
-    let Some(lights) = LightSampler::new(scene) else {
-        return out;
-    };
-    let bsdfs: Vec<Option<Bsdf>> = scene.materials.iter().map(bsdf_of).collect();
     let tracer = Tracer {
         scene,
         params,
         plan,
-        lights: &lights,
-        bsdfs: &bsdfs,
     };
     for i in range {
         tracer.trace_path(i, &mut out);
@@ -115,24 +99,10 @@ pub fn trace_parallel(scene: &Scene, params: &EmitParams, plan: &Plan, chunk: u6
     out
 }
 
-/// The BSDF photons see at a material; `None` for black (absorbing) surfaces.
-fn bsdf_of(m: &Material) -> Option<Bsdf> {
-    match *m {
-        Material::Lambertian { albedo } => {
-            is_diffuse(m).then_some(Bsdf::Lambertian(Lambertian { albedo }))
-        }
-        Material::Mirror { reflectance } => Some(Bsdf::Mirror(Mirror { reflectance })),
-        Material::Metal { reflectance } => Some(Bsdf::Metal(Metal { reflectance })),
-        Material::Dielectric { ior } => Some(Bsdf::Dielectric(Dielectric { eta: ior })),
-    }
-}
-
 struct Tracer<'a> {
     scene: &'a Scene,
     params: &'a EmitParams,
     plan: &'a Plan,
-    lights: &'a LightSampler,
-    bsdfs: &'a [Option<Bsdf>],
 }
 
 impl Tracer<'_> {
@@ -141,8 +111,9 @@ impl Tracer<'_> {
         // Fixed layout: 5 numbers to emit, then 3 per hit, used or not.
         let (u_light, u_pos, u_dir) = (rng.uniform(), rng.uniform2(), rng.uniform2());
         let e = self
-            .lights
-            .sample(u_light, u_pos, u_dir, self.params.photons);
+            .scene
+            .light_table
+            .emit(u_light, u_pos, u_dir, self.params.photons);
         let mut flux = e.flux.as_vec3();
         let mut ray = e.ray;
         let mut specular_bounces = 0u32;
@@ -156,12 +127,12 @@ impl Tracer<'_> {
                 return;
             };
             let (uc, u) = (rng.uniform(), rng.uniform2());
-            let Some(bsdf) = self.bsdfs[hit.material as usize] else {
+            let Some(bsdf) = self.scene.bsdf(hit.material) else {
                 return;
             };
             let d = ray.d.normalize();
             if let Bsdf::Lambertian(Lambertian { albedo }) = bsdf {
-                let photon = || Photon::new(hit.point.p, flux, d, prim_id(hit.prim));
+                let photon = || Photon::new(hit.point.p, flux, d, surface_id(hit.prim));
                 if self.plan.global && (hit_index > 0 || self.params.store_direct) {
                     out.global.push(photon());
                 }
@@ -193,13 +164,7 @@ impl Tracer<'_> {
                 return;
             };
             let wi = frame.to_world(s.wi).normalize();
-            let cos_i = wi.dot(ng);
-            let consistent = if s.is_transmission() {
-                cos_i * cos_o < 0.0
-            } else {
-                cos_i * cos_o > 0.0
-            };
-            if !consistent {
+            if !sides_agree(wo, wi, ng, wo_local, s.wi) {
                 return;
             }
             if s.is_specular() {

@@ -19,16 +19,14 @@
 //! - Pixel sample `s` of pixel `p` draws from `Rng::for_index(seed, p * spp + s)`, tiles
 //!   accumulate in private f64 buffers merged in tile order, so the film is bit-identical for
 //!   any thread count (style anchor A1.8).
-//! - Sampling takes its random numbers as arguments ([`LightSampler::sample`]); only the
+//! - Sampling takes its random numbers as arguments (`scene::LightTable::sample`); only the
 //!   path loop owns an [`math::Rng`].
 
-mod light;
 mod path;
 mod photon;
 mod render;
 
-pub use light::{LightSample, LightSampler};
-pub use path::{Part, PathOptions, PathTracer, Radiance, bsdf_of};
+pub use path::{Part, PathOptions, PathTracer, Radiance};
 pub use photon::{Irradiance, MapLookup, PhotonMethod, render_photon_map};
 pub use render::{RenderOptions, render};
 

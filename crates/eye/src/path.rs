@@ -1,22 +1,11 @@
 //! The path loop: NEE + BSDF sampling with MIS, Russian roulette, and the classification of
 //! every contribution into one [`Part`].
 
-use crate::LightSampler;
-use bsdf::{Bsdf, Dielectric, Lambertian, Metal, Mirror, TransportMode};
+use bsdf::TransportMode;
 use geom::Ray;
 use glam::Vec3;
 use math::{Frame, Rng, power_heuristic};
-use scene::{Material, Scene};
-
-/// The scattering model of a scene material.
-pub fn bsdf_of(m: &Material) -> Bsdf {
-    match *m {
-        Material::Lambertian { albedo } => Lambertian { albedo }.into(),
-        Material::Mirror { reflectance } => Mirror { reflectance }.into(),
-        Material::Metal { reflectance } => Metal { reflectance }.into(),
-        Material::Dielectric { ior } => Dielectric { eta: ior }.into(),
-    }
-}
+use scene::{LightTable, Scene, sides_agree};
 
 /// Which family of light paths a contribution belongs to (Heckbert's notation, read from the
 /// light: `L` light, `S` specular (delta) bounce, `D` non-delta bounce, `E` eye). The parts
@@ -113,12 +102,10 @@ impl PathOptions {
     }
 }
 
-/// A scene prepared for path tracing: BSDF per material and the light sampler. Shared
-/// read-only by all render threads.
+/// The path tracer over a loaded scene (its BSDFs and light table, built once at load).
+/// Shared read-only by all render threads.
 pub struct PathTracer<'a> {
     scene: &'a Scene,
-    bsdfs: Vec<Bsdf>,
-    lights: LightSampler,
     opts: PathOptions,
 }
 
@@ -126,33 +113,17 @@ pub struct PathTracer<'a> {
 /// lossless mirrors still end (pbrt-v4 stops at the same value's complement in spirit).
 const MAX_SURVIVAL: f32 = 0.95;
 
-/// The shading-normal guard against light leaks (pbrt-v4 §10.1.1; Veach 1997 §5.3): a pair
-/// of directions counts as reflection (or transmission) for the BSDF, which reads the
-/// shading normal, only if the geometric normal agrees. Otherwise the pair would carry light
-/// through the surface (or stop it at the surface) where the true geometry does the opposite.
-#[inline]
-pub(crate) fn sides_agree(wo: Vec3, wi: Vec3, ng: Vec3, wo_l: Vec3, wi_l: Vec3) -> bool {
-    let geometric_reflection = wo.dot(ng) * wi.dot(ng) > 0.0;
-    let shading_reflection = wo_l.z * wi_l.z > 0.0;
-    geometric_reflection == shading_reflection
-}
-
 impl<'a> PathTracer<'a> {
     pub fn new(scene: &'a Scene, opts: PathOptions) -> PathTracer<'a> {
-        PathTracer {
-            scene,
-            bsdfs: scene.materials.iter().map(bsdf_of).collect(),
-            lights: LightSampler::new(scene),
-            opts,
-        }
+        PathTracer { scene, opts }
     }
 
     pub fn scene(&self) -> &Scene {
         self.scene
     }
 
-    pub fn lights(&self) -> &LightSampler {
-        &self.lights
+    pub fn lights(&self) -> &LightTable {
+        &self.scene.light_table
     }
 
     pub fn options(&self) -> PathOptions {
@@ -165,6 +136,7 @@ impl<'a> PathTracer<'a> {
     /// stream.
     pub fn li(&self, ray: Ray, rng: &mut Rng) -> Radiance {
         let geometry = &self.scene.geometry;
+        let lights = &self.scene.light_table;
         let mut out = Radiance::default();
         let mut ray = ray;
         let mut beta = Vec3::ONE;
@@ -176,13 +148,13 @@ impl<'a> PathTracer<'a> {
         let mut bounces = 0u32;
         while let Some(hit) = geometry.intersect(&ray) {
             // Emission found by the path itself.
-            if let Some(light) = self.lights.light_of(hit.prim) {
-                let le = self.lights.le(light, ray.d);
+            if let Some(light) = lights.light_of(hit.prim) {
+                let le = lights.le(light, ray.d);
                 if le != Vec3::ZERO {
                     if diffuse_vertices == 0 {
                         out.add(Part::Emitted, beta * le);
                     } else if let Some((p, pdf_bsdf)) = from_diffuse {
-                        let pdf_light = self.lights.pdf(light, p, hit.point.p);
+                        let pdf_light = lights.pdf(light, p, hit.point.p);
                         let w = power_heuristic(1, pdf_bsdf, 1, pdf_light);
                         out.add(direct_or_indirect(diffuse_vertices), beta * le * w);
                     } else if self.opts.caustics {
@@ -207,7 +179,10 @@ impl<'a> PathTracer<'a> {
             let u_dir = rng.uniform2();
             let u_rr = rng.uniform();
 
-            let bsdf = self.bsdfs[hit.material as usize];
+            // Black surfaces absorb: nothing more can be added along this path.
+            let Some(bsdf) = self.scene.bsdf(hit.material) else {
+                break;
+            };
             let ng = hit.point.n;
             let frame = Frame::from_z(hit.ns);
             let wo = -ray.d.normalize();
@@ -215,7 +190,7 @@ impl<'a> PathTracer<'a> {
 
             if !bsdf.is_delta() {
                 diffuse_vertices += 1;
-                if let Some(ls) = self.lights.sample(hit.point.p, u_pick, u_light) {
+                if let Some(ls) = lights.sample(hit.point.p, u_pick, u_light) {
                     let wi_l = frame.to_local(ls.wi);
                     let f = bsdf.f(wo_l, wi_l, TransportMode::Radiance);
                     if f != Vec3::ZERO

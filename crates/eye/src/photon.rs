@@ -5,13 +5,13 @@
 //! `density` stay independent of each other.
 
 use crate::render::render_layers;
-use crate::{LightSampler, RenderOptions, bsdf_of};
-use bsdf::{Bsdf, TransportMode};
+use crate::RenderOptions;
+use bsdf::{Bsdf, Lambertian, TransportMode};
 use film::Film;
 use geom::{Hit, Ray};
 use glam::Vec3;
 use math::{Frame, Rng, warp};
-use scene::{Material, Scene};
+use scene::{Scene, sides_agree};
 
 /// Which photon map a lookup reads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,8 +59,6 @@ pub fn render_photon_map(
 ) -> Film {
     let ctx = Ctx {
         scene,
-        bsdfs: scene.materials.iter().map(bsdf_of).collect(),
-        lights: LightSampler::new(scene),
         maps,
         max_depth: scene.render().max_depth,
     };
@@ -107,8 +105,6 @@ struct Vertex {
 
 struct Ctx<'a> {
     scene: &'a Scene,
-    bsdfs: Vec<Bsdf>,
-    lights: LightSampler,
     maps: &'a dyn Irradiance,
     max_depth: u32,
 }
@@ -128,13 +124,18 @@ impl Ctx<'_> {
             let Some(hit) = self.scene.geometry.intersect(&ray) else {
                 break;
             };
-            if count_emission && let Some(light) = self.lights.light_of(hit.prim) {
-                emitted += beta * self.lights.le(light, ray.d);
+            let lights = &self.scene.light_table;
+            if count_emission && let Some(light) = lights.light_of(hit.prim) {
+                emitted += beta * lights.le(light, ray.d);
             }
             let wo = -ray.d.normalize();
             let (u_lobe, u_dir) = (rng.uniform(), rng.uniform2());
-            match &self.scene.materials[hit.material as usize] {
-                Material::Lambertian { albedo } => {
+            // Black surfaces absorb: the path ends with nothing to estimate.
+            let Some(bsdf) = self.scene.bsdf(hit.material) else {
+                break;
+            };
+            match bsdf {
+                Bsdf::Lambertian(Lambertian { albedo }) => {
                     // Shading normals face the geometric one (geom), so this turns both to
                     // the side the ray came from.
                     let n = if wo.dot(hit.point.n) >= 0.0 {
@@ -147,14 +148,13 @@ impl Ctx<'_> {
                         Some(Vertex {
                             hit,
                             n,
-                            albedo: *albedo,
+                            albedo,
                             beta,
                         }),
                     );
                 }
                 _ => {
                     let frame = Frame::from_z(hit.ns);
-                    let bsdf = self.bsdfs[hit.material as usize];
                     let wo_l = frame.to_local(wo);
                     let Some(s) = bsdf.sample(wo_l, u_lobe, u_dir, TransportMode::Radiance) else {
                         break;
@@ -163,7 +163,7 @@ impl Ctx<'_> {
                     // As in the path tracer: end the path where shading and geometric normals
                     // disagree on reflection vs transmission (pbrt-v4 §10.1.1), so both passes
                     // follow the same paths near smooth-shaded silhouettes.
-                    if !crate::path::sides_agree(wo, wi, hit.point.n, wo_l, s.wi) {
+                    if !sides_agree(wo, wi, hit.point.n, wo_l, s.wi) {
                         break;
                     }
                     beta *= s.weight();
@@ -180,7 +180,7 @@ impl Ctx<'_> {
     /// Irradiance at the vertex from the lights by one shadow ray (next-event estimation).
     fn direct(&self, v: &Vertex, rng: &mut Rng) -> Vec3 {
         let (u_pick, u) = (rng.uniform(), rng.uniform2());
-        let Some(ls) = self.lights.sample(v.hit.point.p, u_pick, u) else {
+        let Some(ls) = self.scene.light_table.sample(v.hit.point.p, u_pick, u) else {
             return Vec3::ZERO;
         };
         let cos = ls.wi.dot(v.n);

@@ -3,7 +3,7 @@
 //! errors computed from the samples, and each test checks that its standard error is small
 //! enough for the comparison to mean something.
 
-use crate::{LightSampler, Part, PathOptions, PathTracer, RenderOptions, render};
+use crate::{Part, PathOptions, PathTracer, RenderOptions, render};
 use film::{Film, Normalize};
 use geom::Ray;
 use glam::{DVec3, Vec3};
@@ -160,7 +160,7 @@ fn plane_light() -> Scene {
 #[test]
 fn light_sampler_integrates_irradiance_and_pdfs_agree() {
     let scene = plane_light();
-    let lights = LightSampler::new(&scene);
+    let lights = &scene.light_table;
     let polygon = PLANE_LIGHT.map(DVec3::from_array);
     for (k, p) in PLANE_POINTS.iter().enumerate() {
         let p = Vec3::from_array(*p);

@@ -25,22 +25,7 @@ pub type Estimator<'a> =
 
 /// Unit normal of the surface a photon landed on, turned towards the side it arrived from.
 fn photon_normal(scene: &Scene, p: &store::Photon) -> Option<Vec3> {
-    let n = if p.surface & emit::SPHERE_BIT != 0 {
-        let s = scene
-            .geometry
-            .spheres()
-            .get((p.surface & !emit::SPHERE_BIT) as usize)?;
-        (p.position() - s.center).normalize_or_zero()
-    } else {
-        let t = p.surface as usize;
-        if t >= scene.geometry.mesh().len() {
-            return None;
-        }
-        scene.geometry.mesh().face_normal(t).normalize_or_zero()
-    };
-    if n == Vec3::ZERO {
-        return None;
-    }
+    let n = scene.surface_normal(p.surface, p.position())?;
     Some(if n.dot(p.direction()) > 0.0 { -n } else { n })
 }
 

@@ -15,6 +15,7 @@ mod file;
 mod lights;
 mod load;
 mod material;
+mod world;
 
 pub use camera::Camera;
 pub use error::SceneError;
@@ -22,9 +23,10 @@ pub use file::{
     CameraDesc, EmissionSource, MaterialDesc, MeshDesc, NormalMode, RenderSettings, SceneFile,
     SphereDesc,
 };
-pub use lights::{LightChooser, LightPoint};
+pub use lights::{Emitted, LightPoint, LightSample, LightTable};
 pub use load::{AreaLight, Scene, fnv1a64};
 pub use material::Material;
+pub use world::{SPHERE_BIT, bsdf_of, sides_agree, surface_id};
 
 #[cfg(test)]
 mod tests;

@@ -1,12 +1,19 @@
-//! Choosing a point on the scene's lights: a triangle by emitted power, then a point uniform
-//! on it (pbrt-v4 §12.6.2, §6.5.4). Next-event estimation (`eye`) and photon emission
-//! (`emit`) both start here, so they weigh lights identically.
+//! The light table: every pass that touches a light goes through [`LightTable`], built once
+//! when the scene loads. It chooses a triangle by emitted power and a point uniform on it
+//! (pbrt-v4 §12.6.2, §6.5.4), answers which light a primitive is and what it emits, converts
+//! densities to solid angle for next-event estimation, and emits photons (cosine-weighted
+//! about the emitting normal, Jensen 2001 §5.1). One table means one weighting of lights for
+//! the eye pass and the photon pass. Random numbers come in as arguments (pbrt-v4's habit:
+//! samplers never own a generator).
 
-use crate::Scene;
-use geom::SurfacePoint;
+use crate::AreaLight;
+use geom::{Hit, Prim, Ray, SurfacePoint, TriMesh};
 use glam::{DVec3, Vec3};
-use math::Distribution1D;
-use math::warp::sample_uniform_triangle;
+use math::warp::{sample_cosine_hemisphere, sample_uniform_triangle};
+use math::{Distribution1D, Frame};
+
+/// Marks a triangle that is not a light in the table's lookup.
+const NOT_A_LIGHT: u32 = u32::MAX;
 
 /// A point chosen on a light.
 #[derive(Clone, Copy, Debug)]
@@ -20,24 +27,64 @@ pub struct LightPoint {
     pub point: SurfacePoint,
 }
 
-/// The power distribution over a scene's light triangles.
-#[derive(Clone, Debug)]
-pub struct LightChooser {
-    distribution: Distribution1D,
-    vertices: Vec<[Vec3; 3]>,
-    normals: Vec<Vec3>,
-    /// `π A Le` in f64 from the scene's f32 area and radiance (no f32 rounding of the product).
-    power: Vec<DVec3>,
-    /// Each light's share of the summed RGB power.
-    pmf: Vec<f64>,
+/// A point sampled on a light, seen from a receiving point (next-event estimation).
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Index of the chosen light (into `Scene::lights`).
+    pub light: usize,
+    /// The light point with its error bound (for shadow rays) and the light's emitting normal.
+    pub point: SurfacePoint,
+    /// Emitted radiance towards the receiver (the light faces it: never zero-sided).
+    pub le: Vec3,
+    /// Unit direction from the receiver to the light point.
+    pub wi: Vec3,
+    /// Distance from the receiver to the light point.
+    pub dist: f32,
+    /// Solid-angle density at the receiver, the light choice included.
+    pub pdf: f32,
 }
 
-impl LightChooser {
+/// A photon leaving a light.
+#[derive(Clone, Copy, Debug)]
+pub struct Emitted {
+    /// Starts just off the light (offset past the point's error bound) with a unit direction.
+    pub ray: Ray,
+    /// Index into the scene's `lights`.
+    pub light: usize,
+    /// The point on the light and its normal.
+    pub point: SurfacePoint,
+    /// Flux carried, `Φ_light / (p_light N)`, in f64.
+    pub flux: DVec3,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    vertices: [Vec3; 3],
+    normal: Vec3,
+    area: f32,
+    le: Vec3,
+    /// Frame about the emitting normal (photon directions).
+    frame: Frame,
+    /// `π A Le` in f64 from the scene's f32 area and radiance (no f32 rounding of the product).
+    power: DVec3,
+    /// This light's share of the summed RGB power.
+    pmf: f64,
+}
+
+/// The scene's emissive triangles, ready for sampling (see the module docs).
+#[derive(Clone, Debug)]
+pub struct LightTable {
+    distribution: Distribution1D,
+    entries: Vec<Entry>,
+    /// Light index of each mesh triangle, or `NOT_A_LIGHT`.
+    light_of_triangle: Vec<u32>,
+    total: DVec3,
+}
+
+impl LightTable {
     /// `None` when no light has positive, finite power (scene loading refuses such scenes).
-    pub fn new(scene: &Scene) -> Option<LightChooser> {
-        let mesh = scene.geometry.mesh();
-        let power: Vec<DVec3> = scene
-            .lights
+    pub fn new(mesh: &TriMesh, lights: &[AreaLight]) -> Option<LightTable> {
+        let power: Vec<DVec3> = lights
             .iter()
             .map(|l| std::f64::consts::PI * l.area as f64 * l.le.as_dvec3())
             .collect();
@@ -46,55 +93,194 @@ impl LightChooser {
         if weights.is_empty() || !sum.is_finite() || sum <= 0.0 {
             return None;
         }
-        Some(LightChooser {
+        let mut light_of_triangle = vec![NOT_A_LIGHT; mesh.len()];
+        let entries = lights
+            .iter()
+            .zip(&power)
+            .zip(&weights)
+            .enumerate()
+            .map(|(i, ((l, &power), w))| {
+                light_of_triangle[l.triangle as usize] = i as u32;
+                Entry {
+                    vertices: mesh.vertices(l.triangle as usize),
+                    normal: l.normal,
+                    area: l.area,
+                    le: l.le,
+                    frame: Frame::from_z(l.normal),
+                    power,
+                    pmf: w / sum,
+                }
+            })
+            .collect();
+        Some(LightTable {
             distribution: Distribution1D::new(&weights),
-            vertices: scene
-                .lights
-                .iter()
-                .map(|l| mesh.vertices(l.triangle as usize))
-                .collect(),
-            normals: scene.lights.iter().map(|l| l.normal).collect(),
-            pmf: weights.iter().map(|w| w / sum).collect(),
-            power,
+            entries,
+            light_of_triangle,
+            total: power.iter().fold(DVec3::ZERO, |s, p| s + *p),
         })
     }
 
+    /// Number of emissive triangles.
     pub fn len(&self) -> usize {
-        self.power.len()
+        self.entries.len()
     }
 
-    /// Always false: [`LightChooser::new`] refuses a scene without lights.
+    /// Always false: [`LightTable::new`] refuses a scene without lights.
     pub fn is_empty(&self) -> bool {
-        self.power.is_empty()
+        self.entries.is_empty()
     }
 
     /// Probability of choosing light `i`.
     pub fn pmf(&self, i: usize) -> f64 {
-        self.pmf[i]
+        self.entries[i].pmf
     }
 
     /// Power `π A Le` of light `i`, f64.
     pub fn power(&self, i: usize) -> DVec3 {
-        self.power[i]
+        self.entries[i].power
+    }
+
+    /// Total emitted power of all lights, RGB, f64.
+    pub fn total_power(&self) -> DVec3 {
+        self.total
     }
 
     pub fn vertices(&self, i: usize) -> [Vec3; 3] {
-        self.vertices[i]
+        self.entries[i].vertices
+    }
+
+    /// Area of light triangle `i` (the scene's value).
+    pub fn area(&self, i: usize) -> f32 {
+        self.entries[i].area
+    }
+
+    /// Frame of light `i`: `n` is the emitting side's normal, `s` and `t` its tangents.
+    pub fn frame(&self, i: usize) -> Frame {
+        self.entries[i].frame
+    }
+
+    /// The light index of a primitive, if it is an emissive triangle.
+    pub fn light_of(&self, prim: Prim) -> Option<usize> {
+        match prim {
+            Prim::Triangle(t) => match self.light_of_triangle.get(t as usize) {
+                Some(&i) if i != NOT_A_LIGHT => Some(i as usize),
+                _ => None,
+            },
+            Prim::Sphere(_) => None,
+        }
+    }
+
+    /// Radiance a ray travelling along `d` receives from light `light` (one-sided emission:
+    /// zero when the ray hits the back).
+    pub fn le(&self, light: usize, d: Vec3) -> Vec3 {
+        let e = &self.entries[light];
+        if d.dot(e.normal) < 0.0 {
+            e.le
+        } else {
+            Vec3::ZERO
+        }
     }
 
     /// `u_light` chooses the light, `u_pos` the point (Heitz's triangle map).
-    pub fn sample(&self, u_light: f32, u_pos: [f32; 2]) -> LightPoint {
+    pub fn sample_point(&self, u_light: f32, u_pos: [f32; 2]) -> LightPoint {
         let (i, _, _) = self.distribution.sample(u_light);
-        let v = self.vertices[i];
+        let e = &self.entries[i];
+        let v = e.vertices;
         let b = sample_uniform_triangle(u_pos);
         LightPoint {
             light: i,
-            pmf: self.pmf[i],
+            pmf: e.pmf,
             point: SurfacePoint {
                 p: b.x * v[0] + b.y * v[1] + b.z * v[2],
                 p_err: SurfacePoint::barycentric_error(b.to_array(), v),
-                n: self.normals[i],
+                n: e.normal,
             },
+        }
+    }
+
+    /// Samples a light point as seen from `from`: `u_pick` chooses the triangle, `u` the point.
+    /// `None` when the point cannot send light to `from` (it sees the light's back or lies in
+    /// its plane), which NEE counts as a zero contribution.
+    pub fn sample(&self, from: Vec3, u_pick: f32, u: [f32; 2]) -> Option<LightSample> {
+        let LightPoint {
+            light: i,
+            pmf,
+            point,
+        } = self.sample_point(u_pick, u);
+        let e = &self.entries[i];
+        let to = point.p - from;
+        let dist2 = to.length_squared();
+        if dist2 <= 0.0 || !dist2.is_finite() {
+            return None;
+        }
+        let dist = dist2.sqrt();
+        let wi = to / dist;
+        let cos_light = -wi.dot(e.normal);
+        if cos_light <= 0.0 || cos_light.is_nan() {
+            return None;
+        }
+        let pdf = pmf as f32 / e.area * dist2 / cos_light;
+        if !(pdf.is_finite() && pdf > 0.0) {
+            return None;
+        }
+        Some(LightSample {
+            light: i,
+            point,
+            le: e.le,
+            wi,
+            dist,
+            pdf,
+        })
+    }
+
+    /// Solid-angle density with which [`LightTable::sample`] from `from` produces the point
+    /// `to` on light `light` (the MIS weight of a BSDF-sampled hit). Zero from behind.
+    pub fn pdf(&self, light: usize, from: Vec3, to: Vec3) -> f32 {
+        let e = &self.entries[light];
+        let d = to - from;
+        let dist2 = d.length_squared();
+        if dist2 <= 0.0 || !dist2.is_finite() {
+            return 0.0;
+        }
+        let cos_light = -d.dot(e.normal) / dist2.sqrt();
+        if cos_light <= 0.0 || cos_light.is_nan() {
+            return 0.0;
+        }
+        e.pmf as f32 / e.area * dist2 / cos_light
+    }
+
+    /// [`LightTable::pdf`] for a BSDF-sampled hit, 0 if the hit is not on a light.
+    pub fn pdf_hit(&self, hit: &Hit, from: Vec3) -> f32 {
+        match self.light_of(hit.prim) {
+            Some(i) => self.pdf(i, from, hit.point.p),
+            None => 0.0,
+        }
+    }
+
+    /// Flux of a photon from light `i` when `photons` paths are emitted in all: the
+    /// unbiased estimate `Φ_i / (p_i N)` of its share (Jensen 2001 §5.1, "multiple lights"; the
+    /// course framework's `Φ_light · #lights / #shots` is the uniform-choice special case).
+    /// With `p_i ∝ |Φ_i|` and one emission colour it equals `Φ_total / N` for every light.
+    pub fn flux(&self, i: usize, photons: u64) -> DVec3 {
+        let e = &self.entries[i];
+        e.power / (e.pmf * photons as f64)
+    }
+
+    /// Emit one photon: `u_light` picks the light, `u_pos` the point (Heitz's triangle map),
+    /// `u_dir` the direction (Malley's method about the light's normal).
+    pub fn emit(&self, u_light: f32, u_pos: [f32; 2], u_dir: [f32; 2], photons: u64) -> Emitted {
+        let LightPoint {
+            light: i, point, ..
+        } = self.sample_point(u_light, u_pos);
+        let d = self.entries[i]
+            .frame
+            .to_world(sample_cosine_hemisphere(u_dir))
+            .normalize();
+        Emitted {
+            ray: point.spawn_ray(d),
+            light: i,
+            point,
+            flux: self.flux(i, photons),
         }
     }
 }

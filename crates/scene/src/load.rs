@@ -1,5 +1,6 @@
 use crate::file::{EmissionSource, MaterialDesc, MeshDesc, NormalMode, Scale, SceneFile};
-use crate::{Camera, Material, RenderSettings, SceneError};
+use crate::{Camera, LightTable, Material, RenderSettings, SceneError};
+use bsdf::Bsdf;
 use geom::{Geometry, Sphere, TriMesh, smooth_vertex_normals};
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use std::cell::RefCell;
@@ -30,6 +31,12 @@ pub struct Scene {
     /// Emitted radiance per material (zero for non-emitters).
     pub emission: Vec<Vec3>,
     pub lights: Vec<AreaLight>,
+    /// The lights ready for sampling, built once: next-event estimation and photon emission
+    /// both read it.
+    pub light_table: LightTable,
+    /// BSDF per material (`None`: black, absorbs), built once for every pass
+    /// ([`Scene::bsdf`]).
+    pub bsdfs: Vec<Option<Bsdf>>,
     pub camera: Camera,
     /// FNV-1a hash of the scene file and every file it names, in order.
     pub content_hash: u64,
@@ -332,15 +339,20 @@ impl<'a> Builder<'a> {
             return Err(self.err("emissive spheres are not supported: lights are triangles"));
         }
 
+        let Some(light_table) = LightTable::new(&self.mesh, &lights) else {
+            return Err(self.err("the lights' total power is zero: no light can be sampled"));
+        };
         // The hashes need the whole scene text: `Scene::from_toml` sets them.
         Ok(Scene {
             path: self.scene_path.to_path_buf(),
             file,
             geometry: Geometry::new(self.mesh, self.spheres),
+            bsdfs: self.materials.iter().map(crate::world::bsdf_of).collect(),
             materials: self.materials,
             material_names: self.names,
             emission: self.emission,
             lights,
+            light_table,
             camera,
             content_hash: 0,
             photon_hash: 0,

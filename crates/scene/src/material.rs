@@ -20,8 +20,4 @@ impl Material {
     pub fn is_specular(&self) -> bool {
         !matches!(self, Material::Lambertian { .. })
     }
-
-    pub fn is_diffuse(&self) -> bool {
-        matches!(self, Material::Lambertian { .. })
-    }
 }

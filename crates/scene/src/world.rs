@@ -1,0 +1,77 @@
+//! What every pass asks of a surface, decided once when the scene loads: its BSDF (or that
+//! it absorbs), whether it is diffuse, which side of it a pair of directions lies on, and the
+//! id a photon records for it. The eye pass and the photon pass read these, so they cannot
+//! disagree about a material.
+
+use crate::{Material, Scene};
+use bsdf::{Bsdf, Dielectric, Lambertian, Metal, Mirror};
+use geom::Prim;
+use glam::Vec3;
+
+/// Set in a surface id for a sphere; clear for a triangle.
+pub const SPHERE_BIT: u32 = 0x8000_0000;
+
+/// The scattering model of a material; `None` for a black Lambertian surface, which absorbs
+/// everything: the eye pass ends its path there and photons are neither stored nor bounced.
+pub fn bsdf_of(m: &Material) -> Option<Bsdf> {
+    match *m {
+        Material::Lambertian { albedo } => {
+            (albedo.max_element() > 0.0).then_some(Lambertian { albedo }.into())
+        }
+        Material::Mirror { reflectance } => Some(Mirror { reflectance }.into()),
+        Material::Metal { reflectance } => Some(Metal { reflectance }.into()),
+        Material::Dielectric { ior } => Some(Dielectric { eta: ior }.into()),
+    }
+}
+
+/// The surface id of a primitive: the triangle index, or the sphere index with
+/// [`SPHERE_BIT`] set.
+pub fn surface_id(prim: Prim) -> u32 {
+    match prim {
+        Prim::Triangle(i) => i,
+        Prim::Sphere(i) => i | SPHERE_BIT,
+    }
+}
+
+/// The shading-normal guard against light leaks (pbrt-v4 §10.1.1; Veach 1997 §5.3): a pair
+/// of directions counts as reflection (or transmission) for the BSDF, which reads the
+/// shading normal, only if the geometric normal `ng` agrees. Otherwise the pair would carry
+/// light through the surface (or stop it at the surface) where the true geometry does the
+/// opposite. `wo_l`, `wi_l` are the same directions in the shading frame.
+#[inline]
+pub fn sides_agree(wo: Vec3, wi: Vec3, ng: Vec3, wo_l: Vec3, wi_l: Vec3) -> bool {
+    let geometric_reflection = wo.dot(ng) * wi.dot(ng) > 0.0;
+    let shading_reflection = wo_l.z * wi_l.z > 0.0;
+    geometric_reflection == shading_reflection
+}
+
+impl Scene {
+    /// The BSDF of material `material` (`None`: it absorbs); see [`bsdf_of`].
+    #[inline]
+    pub fn bsdf(&self, material: u32) -> Option<Bsdf> {
+        self.bsdfs[material as usize]
+    }
+
+    /// Diffuse: a non-delta BSDF that reflects something. Photons are stored on diffuse
+    /// surfaces, and photon-map eye passes estimate there; black surfaces are not diffuse.
+    #[inline]
+    pub fn is_diffuse(&self, material: u32) -> bool {
+        self.bsdfs[material as usize].is_some_and(|b| !b.is_delta())
+    }
+
+    /// Unit geometric normal of surface `id` (see [`surface_id`]) at a point `p` on it, or
+    /// `None` for an id the scene does not have.
+    pub fn surface_normal(&self, id: u32, p: Vec3) -> Option<Vec3> {
+        let n = if id & SPHERE_BIT != 0 {
+            let s = self.geometry.spheres().get((id & !SPHERE_BIT) as usize)?;
+            (p - s.center).normalize_or_zero()
+        } else {
+            let t = id as usize;
+            if t >= self.geometry.mesh().len() {
+                return None;
+            }
+            self.geometry.mesh().face_normal(t).normalize_or_zero()
+        };
+        (n != Vec3::ZERO).then_some(n)
+    }
+}
