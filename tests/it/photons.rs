@@ -4,14 +4,15 @@
 
 use bsdf::TransportMode;
 use emit::{EmitParams, Plan, chunks, trace_parallel, trace_range};
-use scene::SPHERE_BIT;
 use eye::{Part, PathOptions, PathTracer};
 use geom::{Hit, Prim, Ray};
 use glam::{DVec3, Vec2, Vec3};
 use math::warp::{sample_cosine_hemisphere, sample_uniform_disk_concentric};
 use math::{Frame, Rng};
+use scene::SPHERE_BIT;
 use scene::{Material, Scene};
 use std::f64::consts::PI;
+use store::MapKind;
 use tests::{load, scenes_dir};
 
 /// The region R: floor points within this distance of the point under the glass sphere's
@@ -84,8 +85,7 @@ fn photon_flux(scene: &Scene, paths: u64, batches: u64) -> (DVec3, DVec3, usize)
     for r in chunks(paths, paths / batches) {
         let t = trace_range(scene, &params, &plan, r);
         let mut sum = DVec3::ZERO;
-        for ph in t
-            .caustic
+        for ph in t[MapKind::Caustic]
             .iter()
             .filter(|ph| in_region(scene, ph.position(), ph.surface))
         {
@@ -255,10 +255,9 @@ fn stored_first_hits_carry_the_light_power_of_a_closed_box() {
     let t = trace_parallel(&scene, &params, &plan, 4096);
     // A closed box: every path hits a wall, and its first hit is stored.
     assert_eq!(t.emitted, params.photons);
-    assert_eq!(t.global.len() as u64, params.photons);
-    assert!(t.caustic.is_empty());
-    let stored = t
-        .global
+    assert_eq!(t[MapKind::Global].len() as u64, params.photons);
+    assert!(t[MapKind::Caustic].is_empty());
+    let stored = t[MapKind::Global]
         .iter()
         .fold(DVec3::ZERO, |s, p| s + p.power().as_dvec3());
     // Six faces of area 4, Lambertian emitters of Le = 1: Φ = 24 π.

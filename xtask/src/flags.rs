@@ -22,6 +22,9 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
   compare A.exr B.exr [--mask x0,y0,x1,y1]
                       RMSE, relative MSE and mean absolute error of A against reference B
   info SCENE          load a scene and print what it holds
+  bench ...           updates docs/benchmarks.md: each benchmark builds with the release-lto
+                      profile, echoes its output and records it (command, date, machine) as
+                      its own section, replacing that section's previous run
   bench rays [SCENE] [--runs N] [--compare]
                       single-thread rays/s: 1M coherent camera rays and 1M incoherent rays
                       (default scene: scenes/cornell-spheres/tessellated.toml);
@@ -41,8 +44,19 @@ pub enum Cmd {
     GenScenes,
     /// Arguments passed straight to the photonflow binary (release build).
     Photonflow(Vec<String>),
-    /// The same, built with the `release-lto` profile for benchmarks.
-    Bench(Vec<String>),
+    /// A benchmark: built with the `release-lto` profile, its output recorded in
+    /// docs/benchmarks.md.
+    Bench(Bench),
+}
+
+pub struct Bench {
+    /// `rays`, `photons`, `store` or `knn`: names the section of docs/benchmarks.md.
+    pub what: String,
+    /// The arguments after `cargo xtask bench`, as typed, for the record.
+    pub typed: Vec<String>,
+    /// The photonflow command line: `bench-<what>`, the default scene if none was given, and
+    /// the rest.
+    pub args: Vec<String>,
 }
 
 pub const DEFAULT_SCENE: &str = "scenes/cornell-spheres/tessellated.toml";
@@ -61,27 +75,24 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
                 .map(String::from)
                 .collect(),
         )),
-        ["bench", "rays", rest @ ..] => {
-            let mut out = vec!["bench-rays".to_string()];
-            if rest.first().is_none_or(|s| s.starts_with("--")) {
+        [
+            "bench",
+            what @ ("rays" | "photons" | "store" | "knn"),
+            rest @ ..,
+        ] => {
+            let mut out = vec![format!("bench-{what}")];
+            // The scene benchmarks take a scene first; without one, the worksheet's.
+            let wants_scene = matches!(*what, "rays" | "photons");
+            if wants_scene && rest.first().is_none_or(|s| s.starts_with("--")) {
                 out.push(DEFAULT_SCENE.into());
             }
             out.extend(rest.iter().map(|s| s.to_string()));
-            Ok(Cmd::Bench(out))
+            Ok(Cmd::Bench(Bench {
+                what: what.to_string(),
+                typed: args[1..].to_vec(),
+                args: out,
+            }))
         }
-        ["bench", "photons", rest @ ..] => {
-            let mut out = vec!["bench-photons".to_string()];
-            if rest.first().is_none_or(|s| s.starts_with("--")) {
-                out.push(DEFAULT_SCENE.into());
-            }
-            out.extend(rest.iter().map(|s| s.to_string()));
-            Ok(Cmd::Bench(out))
-        }
-        ["bench", kind @ ("store" | "knn"), rest @ ..] => Ok(Cmd::Bench(
-            std::iter::once(format!("bench-{kind}"))
-                .chain(rest.iter().map(|s| s.to_string()))
-                .collect(),
-        )),
         [other, ..] => Err(format!("unknown command `{other}`\n\n{HELP}")),
     }
 }

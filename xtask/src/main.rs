@@ -1,10 +1,14 @@
-//! `cargo xtask`: project automation in Rust (matklad/cargo-xtask; style anchor B2.6).
+//! `cargo xtask`: project automation in Rust (matklad's cargo-xtask convention).
 //!
 //! xtask links no renderer crate. It builds the `photonflow` binary once, in release, through
 //! `$CARGO` and runs it, so a change to xtask never rebuilds the renderer and vice versa.
+//! Benchmarks build with `release-lto` and record their output in `docs/benchmarks.md`.
 
+mod benchmarks;
 mod flags;
 mod gen_scenes;
+#[cfg(test)]
+mod tests;
 mod tidy;
 
 use std::path::{Path, PathBuf};
@@ -29,8 +33,11 @@ fn run(args: &[String]) -> Result<(), String> {
             Ok(())
         }
         flags::Cmd::GenScenes => gen_scenes::run(&project_root()),
-        flags::Cmd::Photonflow(args) => photonflow("release", &args),
-        flags::Cmd::Bench(args) => photonflow("release-lto", &args),
+        flags::Cmd::Photonflow(args) => photonflow(&build("release")?, &args),
+        // `release-lto` is the profile published numbers use.
+        flags::Cmd::Bench(bench) => {
+            benchmarks::run(&project_root(), &build("release-lto")?, &bench)
+        }
     }
 }
 
@@ -42,9 +49,8 @@ pub fn project_root() -> PathBuf {
         .to_path_buf()
 }
 
-/// Build the `photonflow` binary with cargo profile `profile` and run it with `args` from the
-/// project root. Benchmarks use `release-lto`, the profile we publish numbers for.
-fn photonflow(profile: &str, args: &[String]) -> Result<(), String> {
+/// Build the `photonflow` binary with cargo profile `profile`; returns its path.
+fn build(profile: &str) -> Result<PathBuf, String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let root = project_root();
     let status = Command::new(&cargo)
@@ -65,11 +71,15 @@ fn photonflow(profile: &str, args: &[String]) -> Result<(), String> {
     let target = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| root.join("target"));
-    let exe = target
+    Ok(target
         .join(profile)
-        .join(format!("photonflow{}", std::env::consts::EXE_SUFFIX));
-    let status = Command::new(&exe)
-        .current_dir(&root)
+        .join(format!("photonflow{}", std::env::consts::EXE_SUFFIX)))
+}
+
+/// Run the built binary `exe` with `args` from the project root.
+fn photonflow(exe: &Path, args: &[String]) -> Result<(), String> {
+    let status = Command::new(exe)
+        .current_dir(project_root())
         .args(args)
         .status()
         .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;

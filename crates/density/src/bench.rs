@@ -121,7 +121,7 @@ pub fn bench_coherent(photons: usize, ks: &[usize], res: usize, seed: u64) -> Ve
             store::Photon::new(p, Vec3::ONE, dir, i as u32)
         })
         .collect();
-    let map = PhotonMap::build(photons, 1, IndexKind::KdTree);
+    let map = PhotonMap::build(photons, IndexKind::KdTree);
     let eye = Vec3::new(0.5, 0.5, -1.2);
     let pixels: Vec<(Vec3, Vec3)> = (0..res * res)
         .map(|i| {

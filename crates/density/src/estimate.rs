@@ -1,5 +1,7 @@
-//! The irradiance estimate (algorithms.md §2.1): E(x) = (1/r²) Σ_p Φ_p K(|x − x_p| / r),
-//! r the distance to the k-th nearest photon (a balloon estimator, Jensen 2001 §7.1).
+//! The irradiance estimate E(x) = (1/r²) Σ_p Φ_p K(|x − x_p| / r), K normalised over the
+//! unit disc (Jensen 2001 §7.1; Silverman 1986 §4.2): with k-NN, r is the distance to the
+//! k-th nearest photon (a balloon estimator, bandwidth attached to the query point); with
+//! a fixed radius, r is given (splatting and progressive photon mapping).
 
 use crate::index::{Index, IndexKind, KnnHint, Neighbor};
 use crate::kernel::Kernel;
@@ -19,9 +21,10 @@ pub struct EstimateParams {
     pub kernel: Kernel,
     /// Keep only photons arriving from the normal's side: travel direction · n < 0.
     pub same_side: bool,
-    /// Topological test (worksheet 7, algorithms.md §2.4): keep photon p only if
-    /// |n · (x_p − x)| < eps |x_p − x|, i.e. within asin(eps) of the tangent plane. `None`
-    /// disables it. Rejected photons still count towards k and r (their area is elsewhere).
+    /// Topological test against light leaking across corners (worksheet 7's check): keep
+    /// photon p only if |n · (x_p − x)| < eps |x_p − x|, i.e. within asin(eps) of the
+    /// tangent plane. `None` disables it. Rejected photons still count towards k and r
+    /// (their area is elsewhere).
     pub topo: Option<f32>,
     /// Garcia et al. 2012 ("Description and solution of an unreported intrinsic bias in
     /// photon mapping density estimation with constant kernel", CGF 31(1)): when r is the
@@ -50,72 +53,109 @@ struct Hot {
     power: Vec3,
 }
 
-/// Photons plus a spatial index over their positions.
+/// One photon as a [`PhotonMap`] holds it (its direction decoded), by map index.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MapPhoton {
+    pub position: Vec3,
+    /// Unit direction of travel (towards the surface).
+    pub direction: Vec3,
+    /// Flux, already divided by the number of paths emitted.
+    pub power: Vec3,
+    /// Primitive the photon landed on (`store::Photon::surface`).
+    pub surface: u32,
+}
+
+/// Photons plus a spatial index over their positions. Each photon is stored once, split by
+/// use: its position in the index (the search reads only positions), its direction and
+/// power in `hot`, its surface id in `surface` (with the kd-tree, 45 bytes per photon in
+/// all, its slot ids and split axes included, against 73 with a full copy). Map indices
+/// (what [`Neighbor::index`] holds, what the accessors take) run in map order: the
+/// kd-tree's slot order, so neighbours sit together in memory; the order given otherwise.
 pub struct PhotonMap {
-    photons: Vec<Photon>,
-    /// `photons[i].direction()`, decoded once at build, and `photons[i].power`: the
-    /// estimate loop reads these two for every neighbour of every query (k = 1000 over
-    /// 512² pixels is 2.6e8 reads); the octahedral decode (a divide and a normalise, in
-    /// another crate so not inlined) cost a third of a k = 1000 estimate, and one 24-byte
-    /// record with one bounds check beats a 32-byte photon plus a direction. 24 bytes per
-    /// photon.
-    hot: Vec<Hot>,
     index: Index,
-    emitted: u64,
+    /// Direction, decoded once at build, and power: the estimate loop reads these two for
+    /// every neighbour of every query (k = 1000 over 512² pixels is 2.6e8 reads); the
+    /// octahedral decode (a divide and a normalise, in another crate so not inlined) cost a
+    /// third of a k = 1000 estimate, and one 24-byte record with one bounds check beats a
+    /// 32-byte photon plus a direction.
+    hot: Vec<Hot>,
+    surface: Vec<u32>,
 }
 
 impl PhotonMap {
-    /// `emitted`: the number of light paths traced to make these photons (not the number
-    /// stored; anchor A3.3). Estimates divide the stored `power` by it, so photons carry the
-    /// flux of their path as traced. Pass 1 if the powers are already per-emitted-path; 0 is
-    /// treated as 1. With the kd-tree the photons are reordered to tree order (neighbours
-    /// then sit together in memory), so `photons()[i]` is no longer the i-th given.
-    pub fn build(photons: Vec<Photon>, emitted: u64, kind: IndexKind) -> PhotonMap {
+    /// Photons' powers must already be divided by the number of light paths emitted to make
+    /// them (not the number stored): estimates sum them as given. With the kd-tree the
+    /// photons are reordered to its slot order, so map index i is no longer the i-th given.
+    pub fn build(photons: Vec<Photon>, kind: IndexKind) -> PhotonMap {
         let pos: Vec<[f32; 3]> = photons.iter().map(|p| p.pos).collect();
-        let (photons, index) = match Index::build(kind, &pos) {
-            Index::KdTree(mut tree) => {
-                let reordered = tree.order().iter().map(|&i| photons[i as usize]).collect();
-                tree.relabel_by_slot();
-                (reordered, Index::KdTree(tree))
-            }
-            index => (photons, index),
+        let mut index = Index::build(kind, &pos);
+        drop(pos);
+        let order = match &index {
+            Index::KdTree(tree) => Some(tree.order()),
+            _ => None,
         };
-        let hot = photons
-            .iter()
-            .map(|p| Hot {
-                dir: p.direction(),
-                power: p.power(),
+        let given = |i: usize| &photons[order.map_or(i, |o| o[i] as usize)];
+        let hot = (0..photons.len())
+            .map(|i| Hot {
+                dir: given(i).direction(),
+                power: given(i).power(),
             })
             .collect();
+        let surface = (0..photons.len()).map(|i| given(i).surface).collect();
+        if let Index::KdTree(tree) = &mut index {
+            tree.relabel_by_slot();
+        }
         PhotonMap {
-            photons,
-            hot,
             index,
-            emitted,
+            hot,
+            surface,
         }
     }
 
-    pub fn photons(&self) -> &[Photon] {
-        &self.photons
-    }
-
     pub fn len(&self) -> usize {
-        self.photons.len()
+        self.hot.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.photons.is_empty()
+        self.hot.is_empty()
     }
 
-    pub fn emitted(&self) -> u64 {
-        self.emitted
+    pub fn position(&self, i: usize) -> Vec3 {
+        Vec3::from(self.index.points().get(i))
+    }
+
+    /// Unit direction of travel (towards the surface), decoded.
+    pub fn direction(&self, i: usize) -> Vec3 {
+        self.hot[i].dir
+    }
+
+    pub fn power(&self, i: usize) -> Vec3 {
+        self.hot[i].power
+    }
+
+    pub fn surface(&self, i: usize) -> u32 {
+        self.surface[i]
+    }
+
+    pub fn photon(&self, i: usize) -> MapPhoton {
+        MapPhoton {
+            position: self.position(i),
+            direction: self.direction(i),
+            power: self.power(i),
+            surface: self.surface(i),
+        }
+    }
+
+    /// Every photon in map order (spatially coherent with the kd-tree).
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = MapPhoton> + '_ {
+        (0..self.len()).map(|i| self.photon(i))
     }
 
     pub fn index(&self) -> &Index {
         &self.index
     }
 
-    /// k nearest photons within `r_max`, indices into [`PhotonMap::photons`].
+    /// k nearest photons within `r_max`, by map index, sorted by `(d2, index)`.
     pub fn knn(&self, x: Vec3, k: usize, r_max: f32, out: &mut Vec<Neighbor>) {
         self.index.knn(x, k, r_max, out);
     }
@@ -131,6 +171,12 @@ impl PhotonMap {
         out: &mut Vec<Neighbor>,
     ) {
         self.index.knn_hinted(x, k, r_max, hint, out);
+    }
+
+    /// Every photon within `r` of `x`, by map index, sorted by `(d2, index)`
+    /// ([`Index::within`]).
+    pub fn within(&self, x: Vec3, r: f32, out: &mut Vec<Neighbor>) {
+        self.index.within(x, r, out);
     }
 
     /// Irradiance E (flux per area) at `x` on a surface with unit normal `n`; f64 sums.
@@ -195,19 +241,56 @@ impl PhotonMap {
         if !(r2 > 0.0 && r2.is_finite()) {
             return Vec3::ZERO;
         }
-        let drop = p.drop_kth && on_boundary;
-        let inv_r2 = 1.0 / r2;
-        // One loop per kernel (the `match` hoisted out; `shape` inlines to its own arm).
-        // Each closure takes u = d2 / r² and returns exactly `shape(sqrt(u))`: the uniform
-        // kernel needs no square root, since sqrt rounds correctly and monotonically, so
-        // sqrt(u) > 1 exactly when u > 1 + ε (sqrt(1 + ε) rounds down to 1, sqrt(1 + 2ε)
-        // up to 1 + ε). The others keep the root: t·t is not u to the last bit.
         // Dropping the k-th photon: sum around it (keys are unique, indices being unique).
-        let skip = if drop {
+        let skip = if p.drop_kth && on_boundary {
             neighbors.iter().position(|nb| nb.key() == kth)
         } else {
             None
         };
+        self.estimate(x, n, p, r2, skip, neighbors)
+    }
+
+    /// Irradiance at `x` (surface normal `n`, unit length) from every photon within the
+    /// fixed radius `r`: E = (1/r²) Σ Φ_p K(d_p/r), with `p`'s kernel, same-side and
+    /// topological tests (`p.k`, `p.r_max` and `p.drop_kth` play no part: no photon sets
+    /// r). For splatting and progressive estimators, whose radius comes from elsewhere.
+    /// Unbiased on a uniform density away from edges (no k-NN boundary photon). Zero
+    /// unless `r` is positive and finite; clamped like [`PhotonMap::irradiance`]. Bit for
+    /// bit `irradiance` with `k = usize::MAX` and `r_max = r`. `scratch` holds the photons
+    /// found, in index order.
+    pub fn irradiance_within(
+        &self,
+        x: Vec3,
+        n: Vec3,
+        r: f32,
+        p: &EstimateParams,
+        scratch: &mut Vec<Neighbor>,
+    ) -> Vec3 {
+        if !(r > 0.0 && r.is_finite()) {
+            scratch.clear();
+            return Vec3::ZERO;
+        }
+        // Index order, as `irradiance` sums: the result does not depend on the back-end.
+        self.index.within_in_index_order(x, r, scratch);
+        if scratch.is_empty() {
+            return Vec3::ZERO;
+        }
+        // As `irradiance_from_neighbors` squares a finite r_max.
+        self.estimate(x, n, p, (r as f64).powi(2), None, scratch)
+    }
+
+    /// (norm / r²) Σ Φ_p shape(d2_p / r²) over `neighbors` (but `skip`) passing `p`'s
+    /// tests, in the order given; `r2` positive and finite.
+    fn estimate(
+        &self,
+        x: Vec3,
+        n: Vec3,
+        p: &EstimateParams,
+        r2: f64,
+        skip: Option<usize>,
+        neighbors: &[Neighbor],
+    ) -> Vec3 {
+        let inv_r2 = 1.0 / r2;
         let f = Filter {
             x,
             n,
@@ -216,6 +299,11 @@ impl PhotonMap {
             topo: p.topo,
             inv_r2,
         };
+        // One loop per kernel (the `match` hoisted out; `shape` inlines to its own arm).
+        // Each closure takes u = d2 / r² and returns exactly `shape(sqrt(u))`: the uniform
+        // kernel needs no square root, since sqrt rounds correctly and monotonically, so
+        // sqrt(u) > 1 exactly when u > 1 + ε (sqrt(1 + ε) rounds down to 1, sqrt(1 + 2ε)
+        // up to 1 + ε). The others keep the root: t·t is not u to the last bit.
         let sum = match p.kernel {
             Kernel::Uniform => self.sum(&f, neighbors, |u| {
                 if u > 1.0 + f64::EPSILON { 0.0 } else { 1.0 }
@@ -231,7 +319,7 @@ impl PhotonMap {
             Kernel::Silverman => self.sum(&f, neighbors, |u| Kernel::Silverman.shape(u.sqrt())),
             Kernel::Triweight => self.sum(&f, neighbors, |u| Kernel::Triweight.shape(u.sqrt())),
         };
-        let e = sum * (p.kernel.norm() * inv_r2 / self.emitted.max(1) as f64);
+        let e = sum * (p.kernel.norm() * inv_r2);
         e.as_vec3().clamp(Vec3::ZERO, Vec3::splat(f32::MAX))
     }
 
@@ -275,6 +363,7 @@ impl PhotonMap {
         shape: &impl Fn(f64) -> f64,
     ) -> DVec3 {
         let eps = f.topo.unwrap_or(0.0);
+        let pts = self.index.points();
         for nb in neighbors {
             let i = nb.index as usize;
             let h = self.hot[i];
@@ -284,7 +373,7 @@ impl PhotonMap {
                 keep = false;
             }
             if TOPO {
-                let v = self.photons[i].position() - f.x;
+                let v = Vec3::from(pts.get(i)) - f.x;
                 let len = v.length();
                 // A photon at x itself lies in every tangent plane.
                 keep &= !(len > 0.0 && f.n.dot(v).abs() >= eps * len);

@@ -2,7 +2,8 @@
 //!
 //! Each kernel is a *shape* (unnormalised profile, zero for t > 1) times a *norm* making
 //! `∫_disc K = 1`; the estimator evaluates the norm once per query and the shape per photon.
-//! Constants (algorithms.md §2.2; Silverman 1986, "Density Estimation", table 3.1 in 2-D):
+//! Constants (Silverman 1986, "Density Estimation", table 3.1, in 2-D; Jensen 2001 §7.2 for
+//! the cone and Gaussian filters):
 //!
 //! | kernel | K(t), t <= 1 |
 //! |---|---|

@@ -20,9 +20,9 @@
 //!
 //! Pure functions of their arguments; f32 per element (the finite-difference tests use f64).
 
-use scene::{Emitted, LightTable};
 use glam::Vec3;
 use math::Frame;
+use scene::{Emitted, LightTable};
 
 /// Smallest `cos θ` about the light normal used for the angular footprint ([`emit_diff`]):
 /// grazing emission would give an unbounded solid-angle cell.

@@ -1,10 +1,9 @@
-//! Tests of features, not code (anchor B3): the plan against the scenes in `scenes/`, flux
+//! Tests of features, not code (matklad, "How to Test"): the plan against the scenes in `scenes/`, flux
 //! conservation in a closed box, caustic classification in the worksheet scene, determinism
 //! over any split, and the emission distribution against its pdf.
 
 use crate::{
-    EMIT_STREAM, EmitParams, Plan, PlanError, Traced, chunks,
-    trace_parallel, trace_range,
+    EMIT_STREAM, EmitParams, Plan, PlanError, Traced, chunks, trace_parallel, trace_range,
 };
 use glam::DVec3;
 use math::chi2::{chi2_test, pearson};
@@ -12,6 +11,7 @@ use math::warp::cosine_hemisphere_pdf;
 use math::{Frame, Rng};
 use scene::{Material, SPHERE_BIT, Scene};
 use std::path::{Path, PathBuf};
+use store::MapKind;
 
 fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
@@ -135,16 +135,20 @@ fn scenes_without_specular_surfaces_trace_no_caustic_photons() {
             "{p}"
         );
         let t = trace_range(&scene, &asked, &p, 0..asked.photons);
-        assert_eq!(t.caustic.len(), 0, "{rel}");
-        assert!(t.global.len() > 1000, "{rel}: {} global", t.global.len());
+        assert_eq!(t[MapKind::Caustic].len(), 0, "{rel}");
+        assert!(
+            t[MapKind::Global].len() > 1000,
+            "{rel}: {} global",
+            t[MapKind::Global].len()
+        );
         // Even a plan forced to want caustics finds none: no path here is L S+ D.
         let forced = Plan {
             caustic: true,
             ..p.clone()
         };
         let t2 = trace_range(&scene, &asked, &forced, 0..asked.photons);
-        assert_eq!(t2.caustic.len(), 0, "{rel}");
-        assert_eq!(t2.global, t.global, "{rel}");
+        assert_eq!(t2[MapKind::Caustic].len(), 0, "{rel}");
+        assert_eq!(t2[MapKind::Global], t[MapKind::Global], "{rel}");
     }
 }
 
@@ -165,7 +169,14 @@ fn scenes_without_diffuse_surfaces_trace_nothing() {
         "{text}"
     );
     let t = trace_range(&scene, &params(1000), &p, 0..1000);
-    assert_eq!((t.emitted, t.global.len(), t.caustic.len()), (1000, 0, 0));
+    assert_eq!(
+        (
+            t.emitted,
+            t[MapKind::Global].len(),
+            t[MapKind::Caustic].len()
+        ),
+        (1000, 0, 0)
+    );
 }
 
 #[test]
@@ -227,7 +238,7 @@ fn photon_flux_is_total_power_over_paths_emitted() {
         // And the f64 total agrees with the scene's own (f32-rounded) sum.
         assert!(rel_err(lights.total_power(), scene.light_power().as_dvec3()) < 1e-6);
     }
-    // Worksheet numbers (scene-facts.md): Φ = 26.80 (36.8, 31.2, 16.0) = (986.3, 836.2, 428.8).
+    // The course worksheet's numbers for its light: Φ = 26.80 (36.8, 31.2, 16.0) = (986.3, 836.2, 428.8).
     let cornell = load("cornell-spheres/analytic.toml").light_table;
     let want = DVec3::new(986.3, 836.2, 428.8);
     assert!(
@@ -340,16 +351,16 @@ fn first_hits_carry_exactly_the_light_power_in_a_closed_box() {
     };
     let t = trace(&scene, &p);
     // In a closed box every path hits a wall, and every first hit is stored.
-    assert_eq!(t.global.len() as u64, p.photons);
+    assert_eq!(t[MapKind::Global].len() as u64, p.photons);
     let power = scene.light_table.clone().total_power();
-    let stored = sum_power(&t.global);
+    let stored = sum_power(&t[MapKind::Global]);
     assert!(
         rel_err(stored, power) < 1e-6,
         "stored {stored}, emitted {power}"
     );
     // Every photon carries the same flux, Φ / N rounded to f32 once.
     let each = (power / p.photons as f64).as_vec3();
-    assert!(t.global.iter().all(|ph| ph.power() == each));
+    assert!(t[MapKind::Global].iter().all(|ph| ph.power() == each));
 }
 
 #[test]
@@ -367,7 +378,7 @@ fn russian_roulette_keeps_the_expected_flux_in_a_closed_box() {
     let expected = power * (one - rho.powf(d)) / (one - rho);
     // Standard error from the spread of 40 independent batches of 1000 paths.
     let batches: Vec<DVec3> = chunks(p.photons, 1000)
-        .map(|r| sum_power(&trace_range(&scene, &p, &pl, r).global))
+        .map(|r| sum_power(&trace_range(&scene, &p, &pl, r)[MapKind::Global]))
         .collect();
     let k = batches.len() as f64;
     let total: DVec3 = batches.iter().sum();
@@ -390,8 +401,8 @@ fn no_photon_gains_power_at_a_diffuse_bounce() {
     // RR with P = max(ρΦ)/max(Φ) keeps the largest channel of a photon's power constant.
     let scene = furnace([0.8, 0.5, 0.2]);
     let t = trace(&scene, &params(2000));
-    let first = t.global[0].power().max_element();
-    for ph in &t.global {
+    let first = t[MapKind::Global][0].power().max_element();
+    for ph in &t[MapKind::Global] {
         assert!(
             (ph.power().max_element() - first).abs() <= 1e-6 * first,
             "{:?}",
@@ -407,8 +418,8 @@ fn caustic_photons_lie_on_diffuse_surfaces_and_gather_under_the_glass_sphere() {
     let scene = load("cornell-spheres/analytic.toml");
     let p = params(20_000);
     let t = trace(&scene, &p);
-    assert!(!t.caustic.is_empty());
-    for ph in t.caustic.iter().chain(&t.global) {
+    assert!(!t[MapKind::Caustic].is_empty());
+    for ph in t[MapKind::Caustic].iter().chain(&t[MapKind::Global]) {
         let m = material_at(&scene, ph.surface);
         assert!(
             matches!(m, Material::Lambertian { albedo } if albedo.max_element() > 0.0),
@@ -418,8 +429,7 @@ fn caustic_photons_lie_on_diffuse_surfaces_and_gather_under_the_glass_sphere() {
     // The floor is y = 0; the glass sphere (r = 2.25) stands over (-3.272, -6.2395).
     let glass = glam::Vec2::new(-3.272, -6.2395);
     let silver = glam::Vec2::new(-10.505, -9.23675);
-    let floor: Vec<_> = t
-        .caustic
+    let floor: Vec<_> = t[MapKind::Caustic]
         .iter()
         .filter(|ph| ph.pos[1].abs() < 1e-3)
         .collect();
@@ -462,15 +472,21 @@ fn global_photons_include_direct_hits_iff_store_direct() {
         trace(&scene, &direct_only),
     );
     // Storing draws no random numbers: the paths are the same, only the first hits differ.
-    assert!(d.global.len() > 1000, "{} direct hits", d.global.len());
-    assert_eq!(a.global.len(), b.global.len() + d.global.len());
-    let rest: Vec<_> = a
-        .global
+    assert!(
+        d[MapKind::Global].len() > 1000,
+        "{} direct hits",
+        d[MapKind::Global].len()
+    );
+    assert_eq!(
+        a[MapKind::Global].len(),
+        b[MapKind::Global].len() + d[MapKind::Global].len()
+    );
+    let rest: Vec<_> = a[MapKind::Global]
         .iter()
-        .filter(|p| !d.global.contains(p))
+        .filter(|p| !d[MapKind::Global].contains(p))
         .copied()
         .collect();
-    assert_eq!(rest, b.global);
+    assert_eq!(rest, b[MapKind::Global]);
     assert_eq!(
         trace(
             &scene,
@@ -478,15 +494,14 @@ fn global_photons_include_direct_hits_iff_store_direct() {
                 max_depth: 1,
                 ..without.clone()
             }
-        )
-        .global
-        .len(),
+        )[MapKind::Global]
+            .len(),
         0
     );
     // The caustic set never holds direct hits, whatever store_direct says.
-    assert_eq!(a.caustic, b.caustic);
+    assert_eq!(a[MapKind::Caustic], b[MapKind::Caustic]);
     // Direct photons of the worksheet light travel downwards.
-    assert!(d.global.iter().all(|p| p.direction().y < 0.0));
+    assert!(d[MapKind::Global].iter().all(|p| p.direction().y < 0.0));
 }
 
 // --- Determinism ---------------------------------------------------------------------------
@@ -497,7 +512,7 @@ fn any_split_of_the_paths_gives_the_same_photons() {
     let p = params(3000);
     let pl = plan(&scene, &p);
     let whole = trace_range(&scene, &p, &pl, 0..p.photons);
-    assert!(whole.global.len() > 5000 && !whole.caustic.is_empty());
+    assert!(whole[MapKind::Global].len() > 5000 && !whole[MapKind::Caustic].is_empty());
     assert_eq!(whole.emitted, 3000);
     for cuts in [vec![0, 1, 700, 701, 3000], vec![0, 1500, 3000]] {
         let mut joined = Traced::default();
@@ -512,8 +527,13 @@ fn any_split_of_the_paths_gives_the_same_photons() {
     }
     assert_eq!(joined, whole);
     // Bit-identical, not merely equal as floats.
-    let bits =
-        |t: &Traced| -> Vec<u32> { t.global.iter().chain(&t.caustic).flat_map(words).collect() };
+    let bits = |t: &Traced| -> Vec<u32> {
+        t[MapKind::Global]
+            .iter()
+            .chain(&t[MapKind::Caustic])
+            .flat_map(words)
+            .collect()
+    };
     assert_eq!(bits(&joined), bits(&whole));
     // Two rayon threads, chunks finishing in any order.
     let pool = rayon::ThreadPoolBuilder::new()
@@ -549,8 +569,8 @@ fn a_caustic_only_run_finds_the_same_caustic_photons() {
         ..both.clone()
     };
     let (a, c) = (trace(&scene, &both), trace(&scene, &only));
-    assert!(c.global.is_empty() && !c.caustic.is_empty());
-    assert_eq!(a.caustic, c.caustic);
+    assert!(c[MapKind::Global].is_empty() && !c[MapKind::Caustic].is_empty());
+    assert_eq!(a[MapKind::Caustic], c[MapKind::Caustic]);
 }
 
 #[test]
@@ -559,7 +579,10 @@ fn the_seed_selects_the_photons() {
     let mut b = load("corner/corner.toml");
     b.file.seed = 2;
     let p = params(200);
-    assert_ne!(trace(&a, &p).global, trace(&b, &p).global);
+    assert_ne!(
+        trace(&a, &p)[MapKind::Global],
+        trace(&b, &p)[MapKind::Global]
+    );
     assert_eq!(trace(&a, &p), trace(&load("corner/corner.toml"), &p));
     assert_ne!(EMIT_STREAM, 0);
 }
@@ -605,8 +628,12 @@ fn photons_record_their_surface_and_direction_of_travel() {
         },
     );
     // The corner is open: 1077 of 2000 paths hit it (seed 1).
-    assert!(t.global.len() > 900, "{} of 2000 paths hit", t.global.len());
-    for ph in &t.global {
+    assert!(
+        t[MapKind::Global].len() > 900,
+        "{} of 2000 paths hit",
+        t[MapKind::Global].len()
+    );
+    for ph in &t[MapKind::Global] {
         assert_eq!(ph.surface & SPHERE_BIT, 0);
         let [a, b, c] = scene.geometry.mesh().vertices(ph.surface as usize);
         let n = (b - a).cross(c - a).normalize();

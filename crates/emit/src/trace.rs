@@ -7,27 +7,41 @@ use math::{Frame, Rng};
 use rayon::prelude::*;
 use scene::{Scene, sides_agree, surface_id};
 use std::ops::Range;
-use store::Photon;
+use store::{MapKind, PerKind, Photon};
 
 /// Mixed into the scene seed for photon streams, so photon `i` and the eye pass's sample `i`
 /// never share random numbers ("emitphot" in ASCII).
 pub const EMIT_STREAM: u64 = 0x656d_6974_7068_6f74;
 
-/// Photons of a range of paths, in path order (and hit order within a path).
+/// Photons of a range of paths, in path order (and hit order within a path), one set per
+/// map kind (`traced[MapKind::Global]`).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Traced {
-    /// Paths emitted: the range's length, whatever was stored. Estimators divide by the total.
+    /// Paths emitted: the range's length, whatever was stored. Photon powers already carry
+    /// the 1/N of the whole run's emitted count.
     pub emitted: u64,
-    pub global: Vec<Photon>,
-    pub caustic: Vec<Photon>,
+    pub sets: PerKind<Vec<Photon>>,
 }
 
 impl Traced {
     /// Append the photons of the *next* range: concatenation in index order is the whole run.
     pub fn append(&mut self, mut next: Traced) {
         self.emitted += next.emitted;
-        self.global.append(&mut next.global);
-        self.caustic.append(&mut next.caustic);
+        for k in MapKind::ALL {
+            self.sets[k].append(&mut next.sets[k]);
+        }
+    }
+
+    /// Photons stored in all sets.
+    pub fn stored(&self) -> usize {
+        self.sets.iter().map(|(_, s)| s.len()).sum()
+    }
+}
+
+impl std::ops::Index<MapKind> for Traced {
+    type Output = Vec<Photon>;
+    fn index(&self, k: MapKind) -> &Vec<Photon> {
+        &self.sets[k]
     }
 }
 
@@ -134,10 +148,10 @@ impl Tracer<'_> {
             if let Bsdf::Lambertian(Lambertian { albedo }) = bsdf {
                 let photon = || Photon::new(hit.point.p, flux, d, surface_id(hit.prim));
                 if self.plan.global && (hit_index > 0 || self.params.store_direct) {
-                    out.global.push(photon());
+                    out.sets[MapKind::Global].push(photon());
                 }
                 if self.plan.caustic && specular_bounces > 0 && diffuse_bounces == 0 {
-                    out.caustic.push(photon());
+                    out.sets[MapKind::Caustic].push(photon());
                 }
                 // Past a diffuse bounce only the global set can gain photons; past the last
                 // hit, nothing.

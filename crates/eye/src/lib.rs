@@ -18,7 +18,7 @@
 //!   after a diffuse vertex is therefore a caustic with MIS weight 1.
 //! - Pixel sample `s` of pixel `p` draws from `Rng::for_index(seed, p * spp + s)`, tiles
 //!   accumulate in private f64 buffers merged in tile order, so the film is bit-identical for
-//!   any thread count (style anchor A1.8).
+//!   any thread count (pbrt-v4 indexes samples by pixel and sample number the same way).
 //! - Sampling takes its random numbers as arguments (`scene::LightTable::sample`); only the
 //!   path loop owns an [`math::Rng`].
 
@@ -27,7 +27,7 @@ mod photon;
 mod render;
 
 pub use path::{Part, PathOptions, PathTracer, Radiance};
-pub use photon::{Irradiance, MapLookup, PhotonMethod, render_photon_map};
+pub use photon::{Irradiance, MapLookup, render_final_gather, render_global_direct};
 pub use render::{RenderOptions, render};
 
 #[cfg(test)]

@@ -4,8 +4,8 @@
 //! to the density stage; this module sees them only through [`Irradiance`], so `eye` and
 //! `density` stay independent of each other.
 
-use crate::render::render_layers;
 use crate::RenderOptions;
+use crate::render::render_layers;
 use bsdf::{Bsdf, Lambertian, TransportMode};
 use film::Film;
 use geom::{Hit, Ray};
@@ -27,33 +27,12 @@ pub trait Irradiance: Sync {
     fn irradiance(&self, map: MapLookup, p: Vec3, n: Vec3) -> Vec3;
 }
 
-/// How photon maps are turned into an image.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PhotonMethod {
-    /// Radiance at the first diffuse vertex seen from the eye (through mirrors and glass) is
-    /// `rho / pi * E_global`: the global map shown directly, no final gathering.
-    GlobalDirect,
-    /// Direct light by next-event estimation, caustics from the caustic map, indirect light by
-    /// `rays` final-gather rays per sample that read the global map where they land.
-    FinalGather { rays: u32 },
-}
-
-impl PhotonMethod {
-    /// Film layers this method writes, in order; their sum is the image.
-    pub fn layers(self) -> &'static [&'static str] {
-        match self {
-            PhotonMethod::GlobalDirect => &["emitted", "global"],
-            PhotonMethod::FinalGather { .. } => &["emitted", "direct", "caustic", "indirect"],
-        }
-    }
-}
-
-/// Renders with photon-map estimates; see [`PhotonMethod`] for the layers. Deterministic for
-/// any thread count, like [`crate::render`].
-pub fn render_photon_map(
+/// The global map shown directly: radiance at the first diffuse vertex seen from the eye
+/// (through mirrors and glass) is `rho / pi * E_global`, no final gathering. Layers
+/// `emitted` and `global`; deterministic for any thread count, like [`crate::render`].
+pub fn render_global_direct(
     scene: &Scene,
     opts: &RenderOptions,
-    method: PhotonMethod,
     maps: &dyn Irradiance,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Film {
@@ -62,35 +41,49 @@ pub fn render_photon_map(
         maps,
         max_depth: scene.render().max_depth,
     };
-    match method {
-        PhotonMethod::GlobalDirect => {
-            render_layers(scene, opts, ["emitted", "global"], progress, &|ray, rng| {
-                let (emitted, first) = ctx.to_diffuse(ray, rng, true);
-                let global = first.map_or(Vec3::ZERO, |v| {
-                    v.beta * v.albedo / std::f32::consts::PI
-                        * maps.irradiance(MapLookup::Global, v.hit.point.p, v.n)
-                });
-                [emitted, global]
-            })
-        }
-        PhotonMethod::FinalGather { rays } => render_layers(
-            scene,
-            opts,
-            ["emitted", "direct", "caustic", "indirect"],
-            progress,
-            &|ray, rng| {
-                let (emitted, first) = ctx.to_diffuse(ray, rng, true);
-                let Some(v) = first else {
-                    return [emitted, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO];
-                };
-                let brdf = v.beta * v.albedo / std::f32::consts::PI;
-                let direct = ctx.direct(&v, rng) * brdf;
-                let caustic = brdf * maps.irradiance(MapLookup::Caustic, v.hit.point.p, v.n);
-                let indirect = ctx.gather(&v, rays, rng) * (v.beta * v.albedo);
-                [emitted, direct, caustic, indirect]
-            },
-        ),
-    }
+    render_layers(scene, opts, ["emitted", "global"], progress, &|ray, rng| {
+        let (emitted, first) = ctx.to_diffuse(ray, rng, true);
+        let global = first.map_or(Vec3::ZERO, |v| {
+            v.beta * v.albedo / std::f32::consts::PI
+                * maps.irradiance(MapLookup::Global, v.hit.point.p, v.n)
+        });
+        [emitted, global]
+    })
+}
+
+/// The course framework's standard (Jensen 2001 §9.3): direct light by next-event
+/// estimation, caustics from the caustic map, indirect light by `rays` final-gather rays per
+/// sample that read the global map where they land. Layers `emitted`, `direct`, `caustic`,
+/// `indirect`; deterministic for any thread count.
+pub fn render_final_gather(
+    scene: &Scene,
+    opts: &RenderOptions,
+    rays: u32,
+    maps: &dyn Irradiance,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Film {
+    let ctx = Ctx {
+        scene,
+        maps,
+        max_depth: scene.render().max_depth,
+    };
+    render_layers(
+        scene,
+        opts,
+        ["emitted", "direct", "caustic", "indirect"],
+        progress,
+        &|ray, rng| {
+            let (emitted, first) = ctx.to_diffuse(ray, rng, true);
+            let Some(v) = first else {
+                return [emitted, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO];
+            };
+            let brdf = v.beta * v.albedo / std::f32::consts::PI;
+            let direct = ctx.direct(&v, rng) * brdf;
+            let caustic = brdf * maps.irradiance(MapLookup::Caustic, v.hit.point.p, v.n);
+            let indirect = ctx.gather(&v, rays, rng) * (v.beta * v.albedo);
+            [emitted, direct, caustic, indirect]
+        },
+    )
 }
 
 /// The first diffuse vertex of an eye path.

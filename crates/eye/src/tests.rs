@@ -453,13 +453,7 @@ fn global_map_shown_directly_is_rho_over_pi_times_e() {
         global: Vec3::new(1.0, 2.0, 4.0),
         caustic: Vec3::ZERO,
     };
-    let film = crate::render_photon_map(
-        &scene,
-        &opts,
-        crate::PhotonMethod::GlobalDirect,
-        &maps,
-        &|_| {},
-    );
+    let film = crate::render_global_direct(&scene, &opts, &maps, &|_| {});
     assert_eq!(film.layer_names(), ["emitted", "global"]);
     let g = film
         .layer("global")
@@ -502,13 +496,7 @@ fn final_gather_in_a_furnace_gives_the_rendering_equation_terms() {
         spp,
         ..RenderOptions::from_scene(&scene)
     };
-    let film = crate::render_photon_map(
-        &scene,
-        &opts,
-        crate::PhotonMethod::FinalGather { rays: 4 },
-        &maps,
-        &|_| {},
-    );
+    let film = crate::render_final_gather(&scene, &opts, 4, &maps, &|_| {});
     let res = |n: &str| {
         film.layer(n)
             .unwrap()

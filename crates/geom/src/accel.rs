@@ -279,12 +279,12 @@ impl Geometry {
     }
 }
 
-/// obvhs' `CwBvh` node test clamps the entry distance to `t >= 1e-4` (`cwbvh/node.rs`,
-/// `EPSILON`), so it skips every node that lies entirely closer than that: in our Cornell
-/// scene, the floor as seen from a point 1e-5 above it. A fixed epsilon is exactly what
-/// `spawn_ray` avoids, so traversal gets a ray whose origin is moved back by `T_SHIFT` (in t
-/// units) along its direction; the triangle test uses the true origin and reports
-/// `t + T_SHIFT`. Regression test: `tests/it/cornell.rs`, `bvh_equals_brute_force...`.
+/// obvhs' `CwBvh` node test clamps the entry distance to `t >= 1e-4` (obvhs 0.4,
+/// `cwbvh::node::EPSILON`), so it skips every node that lies entirely closer than that: in
+/// our Cornell scene, the floor as seen from a point 1e-5 above it. A fixed epsilon is
+/// exactly what `spawn_ray` avoids, so traversal gets a ray whose origin is moved back by
+/// `T_SHIFT` (in t units) along its direction; the triangle test uses the true origin and
+/// reports `t + T_SHIFT`. Regression test: `tests/it/cornell.rs`, `bvh_equals_brute_force...`.
 const T_SHIFT: f32 = 2e-4;
 
 /// The traversal ray (origin moved back by `T_SHIFT`) and the true one, both ending at

@@ -1,9 +1,10 @@
 //! `math`: the vocabulary every renderer crate shares and that knows nothing of scenes,
-//! materials or photons (style anchor A2.1: Mitsuba's `core/` vs `render/` split).
+//! materials or photons (Mitsuba's habit: its `core/` library sits below `render/`).
 //!
 //! Key decision: random numbers are *counter based*. A photon's or a pixel sample's stream is
 //! a pure function of `(seed, index)` ([`Rng::for_index`]), so any work split over threads
-//! reproduces the same numbers bit for bit (anchor A1.8, pbrt-v4's SPPM photon indexing).
+//! reproduces the same numbers bit for bit (pbrt-v4's habit in SPPM: a photon's samples are
+//! indexed by the photon's number, not drawn from a shared stream).
 //! Vectors are `glam`'s; this crate adds what glam lacks.
 
 pub mod chi2;

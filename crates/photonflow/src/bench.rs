@@ -97,8 +97,14 @@ fn random_rays(geo: &Geometry, count: usize, seed: u64) -> Vec<Ray> {
 /// photon files. Median of `runs`.
 pub fn photons(path: &Path, count: u64, runs: usize) -> Result<(), String> {
     let s = scene::Scene::load(path).map_err(|e| e.to_string())?;
-    let mut params = crate::trace::params(&s, Some(count))?;
-    params.photons = count;
+    let params = pipeline::Settings::new(
+        &s,
+        &pipeline::Overrides {
+            photons: Some(count),
+            ..Default::default()
+        },
+    )?
+    .emit;
     let plan = emit::Plan::for_scene(&s, &params).map_err(|e| e.to_string())?;
     println!(
         "scene {}, {count} photon paths per run, median of {runs} runs",
@@ -122,10 +128,7 @@ pub fn photons(path: &Path, count: u64, runs: usize) -> Result<(), String> {
                     .collect()
             });
             rates.push(count as f64 / t.elapsed().as_secs_f64());
-            stored = traced
-                .iter()
-                .map(|t| t.global.len() + t.caustic.len())
-                .sum();
+            stored = traced.iter().map(emit::Traced::stored).sum();
         }
         rates.sort_by(f64::total_cmp);
         println!(
@@ -138,21 +141,23 @@ pub fn photons(path: &Path, count: u64, runs: usize) -> Result<(), String> {
     for threads in [1usize, 2] {
         let mut rates = Vec::new();
         for _ in 0..runs.max(1) {
-            let key = crate::pipeline::CacheKey::new(&s, &params);
-            let files: Vec<_> = crate::pipeline::planned_kinds(&plan)
+            use pipeline::flow::{self, PipelineOptions, Sink, StoreSink};
+            let key = pipeline::photon_cache::CacheKey::new(&s, &params);
+            let files: Vec<_> = pipeline::photon_cache::planned_kinds(&plan)
                 .into_iter()
                 .map(|k| (k, key.file(&dir, k)))
                 .collect();
-            let progress = crate::progress::Progress::hidden();
-            let stats = crate::pipeline::run(
+            let progress = pipeline::progress::Progress::hidden();
+            let mut store = StoreSink::create(&files, &|k| key.header(&s, k))?;
+            let stats = flow::run(
                 &s,
                 &params,
                 &plan,
-                &key,
-                &files,
-                &crate::pipeline::PipelineOptions::new(threads),
+                &mut [&mut store as &mut dyn Sink],
+                &PipelineOptions::new(threads),
                 &progress,
             )?;
+            store.finish(params.photons)?;
             rates.push(count as f64 / stats.seconds);
         }
         rates.sort_by(f64::total_cmp);

@@ -3,19 +3,12 @@
 //! nothing here panics on bad input.
 
 mod bench;
-mod cache;
-mod estimate;
-mod pipeline;
-mod progress;
-mod render;
-mod trace;
-mod worksheet;
-
-#[cfg(test)]
-mod tests;
+mod composite;
 
 use clap::{Parser, Subcommand};
-use std::path::PathBuf;
+use pipeline::{Overrides, Photons, RenderRequest};
+use scene::{Method, Scene};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -72,7 +65,7 @@ enum Cmd {
         /// path, global-direct or final-gather (default: the scene's render.method, whose
         /// default is final-gather).
         #[arg(long)]
-        method: Option<String>,
+        method: Option<Method>,
         #[command(flatten)]
         photon: PhotonArgs,
         #[command(flatten)]
@@ -87,7 +80,7 @@ enum Cmd {
         /// global-direct (the global map shown directly) or final-gather (default: the
         /// scene's render.method when it is one of these, else global-direct).
         #[arg(long)]
-        method: Option<String>,
+        method: Option<Method>,
         #[command(flatten)]
         photon: PhotonArgs,
         #[command(flatten)]
@@ -131,6 +124,17 @@ enum Cmd {
         #[arg(long)]
         force: bool,
     },
+    /// Combine runs of one view (their output directories or `image.exr` paths): layers of
+    /// one name averaged by their counts, disjoint layers summed, in f64, in a fixed order.
+    Composite {
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+        #[arg(long)]
+        out: PathBuf,
+        /// Exposure of the PNG in stops.
+        #[arg(long, default_value_t = 0.0)]
+        exposure: f32,
+    },
     /// Error metrics of image A against reference B (linear EXR files).
     Compare {
         a: PathBuf,
@@ -144,8 +148,8 @@ enum Cmd {
 /// Image settings shared by `render` and `estimate`.
 #[derive(clap::Args)]
 struct ImageArgs {
-    /// Samples per pixel (default: the scene file's render.spp for `path`, 1 for the photon
-    /// methods, which already average many photons per estimate).
+    /// Samples per pixel (default: the scene file's render.spp for `path`, estimate.spp
+    /// (default 1) for the photon methods, which already average many photons per estimate).
     #[arg(long)]
     spp: Option<u32>,
     /// Worker threads (default: all cores). The image does not depend on it.
@@ -173,7 +177,7 @@ struct PhotonArgs {
     k: Option<usize>,
     /// Kernel of the global-map estimate: uniform, silverman, epanechnikov, triweight,
     /// gaussian, gaussian-jensen, cone, cone:K.
-    #[arg(long, value_parser = estimate::parse_kernel)]
+    #[arg(long, value_parser = pipeline::settings::parse_kernel)]
     kernel: Option<density::Kernel>,
     /// Topological test: keep photons whose direction from the estimation point is within
     /// |cos| < EPS of the tangent plane.
@@ -186,13 +190,14 @@ struct PhotonArgs {
     /// mass that lies on the surface (found by short probe rays).
     #[arg(long)]
     boundary: bool,
-    /// Final-gather rays per sample (default: the scene's render.gather_rays, 16).
+    /// Final-gather rays per sample (default: the scene's estimate.final_gather.rays, 16).
     #[arg(long)]
     gather_rays: Option<u32>,
     /// Final gathering reads irradiance precomputed at every N-th global photon
-    /// (Christensen 1999); 0 estimates from the map at every gather hit.
-    #[arg(long, default_value_t = 4)]
-    gather_cache: usize,
+    /// (Christensen 1999); 0 estimates from the map at every gather hit (default: the
+    /// scene's estimate.final_gather.cache, 4).
+    #[arg(long)]
+    gather_cache: Option<usize>,
     /// Compare with this linear EXR (the path-traced reference) and record the error.
     #[arg(long)]
     reference: Option<PathBuf>,
@@ -201,41 +206,41 @@ struct PhotonArgs {
     label: Option<String>,
 }
 
-/// The method a command runs: the flag, else the scene file's `render.method`.
-fn method_of(scene_path: &PathBuf, flag: Option<String>) -> Result<(String, u32), String> {
-    let s = scene::Scene::load(scene_path).map_err(|e| e.to_string())?;
-    let r = s.render();
-    Ok((flag.unwrap_or_else(|| r.method.clone()), r.gather_rays))
-}
-
-fn photon_method(name: &str, rays: u32) -> Result<eye::PhotonMethod, String> {
-    match name {
-        "global-direct" => Ok(eye::PhotonMethod::GlobalDirect),
-        "final-gather" => Ok(eye::PhotonMethod::FinalGather { rays }),
-        other => Err(format!(
-            "unknown photon method `{other}` (global-direct, final-gather)"
-        )),
+impl PhotonArgs {
+    fn overrides(&self, method: Option<Method>, spp: Option<u32>) -> Overrides {
+        Overrides {
+            method,
+            spp,
+            photons: self.photons,
+            k: self.k,
+            kernel: self.kernel,
+            topo: self.topo,
+            drop_kth: self.drop_kth,
+            boundary: self.boundary,
+            gather_rays: self.gather_rays,
+            gather_cache: self.gather_cache,
+            no_caustics: false,
+        }
     }
 }
 
-fn estimate_args(method: eye::PhotonMethod, p: PhotonArgs, i: ImageArgs) -> estimate::EstimateArgs {
-    estimate::EstimateArgs {
-        method,
-        photons: p.photons,
-        cache: p.cache,
-        spp: i.spp,
-        threads: i.threads,
-        out: i.out,
-        k: p.k,
-        kernel: p.kernel,
-        topo: p.topo,
-        drop_kth: p.drop_kth,
-        reference: p.reference,
-        exposure: i.exposure,
-        label: p.label,
-        boundary: p.boundary,
-        gather_cache: p.gather_cache,
+fn load(path: &Path) -> Result<Scene, String> {
+    Scene::load(path).map_err(|e| e.to_string())
+}
+
+/// `render` and `estimate`: the one path through the library, then a summary line.
+fn render(scene: &Scene, req: RenderRequest) -> Result<(), String> {
+    let r = pipeline::render(scene, &req)?;
+    println!(
+        "rendered {} in {:.2} s; wrote {}/image.{{exr,png,json}}, layers/, scene.toml",
+        r.settings.method,
+        r.seconds,
+        r.out.display()
+    );
+    if let Some(m) = &r.metrics {
+        println!("against the reference: {m}");
     }
+    Ok(())
 }
 
 fn parse_rect(s: &str) -> Result<[usize; 4], String> {
@@ -279,62 +284,68 @@ fn run(cmd: Cmd) -> Result<(), String> {
             photon,
             image,
             no_caustics,
-        } => match method_of(&scene, method)? {
-            (m, _) if m == "path" => render::path(render::RenderArgs {
-                scene,
-                spp: image.spp,
+        } => {
+            let s = load(&scene)?;
+            let overrides = Overrides {
                 no_caustics,
-                threads: image.threads,
-                out: image.out,
-                exposure: image.exposure,
-            }),
-            (m, rays) => {
-                let method = photon_method(&m, photon.gather_rays.unwrap_or(rays))
-                    .map_err(|e| format!("{e}; or `path`"))?;
-                let s = scene::Scene::load(&scene).map_err(|e| e.to_string())?;
-                let t = trace::trace(
-                    &s,
-                    &trace::TraceArgs {
-                        photons: photon.photons,
-                        cache: photon.cache.clone(),
-                        threads: image.threads,
-                        force: false,
-                    },
-                )?;
-                let e = estimate::estimate(&s, &estimate_args(method, photon, image))?;
-                println!(
-                    "pipeline: trace {} ({:.2} s) + estimate {:.2} s",
-                    if t.reused { "reused" } else { "traced" },
-                    t.seconds,
-                    e.seconds
-                );
-                Ok(())
-            }
-        },
+                ..photon.overrides(method, image.spp)
+            };
+            render(
+                &s,
+                RenderRequest {
+                    overrides,
+                    cache: &photon.cache,
+                    photons: Photons::TraceOrReuse,
+                    threads: image.threads,
+                    out: image.out,
+                    exposure: image.exposure,
+                    reference: photon.reference.as_deref(),
+                    label: photon.label.clone(),
+                },
+            )
+        }
         Cmd::Estimate {
             scene,
             method,
             photon,
             image,
         } => {
-            if method.as_deref() == Some("path") {
+            if method == Some(Method::Path) {
                 return Err(
                     "estimate reads photon maps: use `render --method path` for the path tracer"
                         .into(),
                 );
             }
-            let (m, rays) = method_of(&scene, method)?;
+            let s = load(&scene)?;
             // A scene whose default is the path tracer still gets a photon method here.
-            let m = if m == "path" {
-                "global-direct".to_string()
-            } else {
-                m
-            };
-            let m = photon_method(&m, photon.gather_rays.unwrap_or(rays))?;
-            let s = scene::Scene::load(&scene).map_err(|e| e.to_string())?;
-            estimate::estimate(&s, &estimate_args(m, photon, image)).map(|_| ())
+            let method = method.unwrap_or(match s.render().method {
+                Method::Path => Method::GlobalDirect,
+                m => m,
+            });
+            render(
+                &s,
+                RenderRequest {
+                    overrides: photon.overrides(Some(method), image.spp),
+                    cache: &photon.cache,
+                    photons: Photons::CacheOnly,
+                    threads: image.threads,
+                    out: image.out,
+                    exposure: image.exposure,
+                    reference: photon.reference.as_deref(),
+                    label: photon.label.clone(),
+                },
+            )
         }
-        Cmd::Compare { a, b, mask } => render::compare(&a, &b, mask),
+        Cmd::Composite {
+            inputs,
+            out,
+            exposure,
+        } => composite::run(&inputs, &out, exposure),
+        Cmd::Compare { a, b, mask } => {
+            let m = pipeline::output::compare(&a, &b, mask)?;
+            println!("{m}");
+            Ok(())
+        }
         Cmd::BenchPhotons {
             scene,
             photons,
@@ -351,16 +362,22 @@ fn run(cmd: Cmd) -> Result<(), String> {
             out,
             cache,
             threads,
-        } => worksheet::run(&worksheet::WorksheetArgs {
-            scene,
-            photons,
-            k,
-            topo,
-            reference_spp,
-            out,
-            cache,
-            threads,
-        }),
+        } => {
+            let s = load(&scene)?;
+            pipeline::worksheet::run(
+                &s,
+                &pipeline::worksheet::WorksheetArgs {
+                    scene,
+                    photons,
+                    k,
+                    topo,
+                    reference_spp,
+                    out,
+                    cache,
+                    threads,
+                },
+            )
+        }
         Cmd::Trace {
             scene,
             photons,
@@ -368,23 +385,18 @@ fn run(cmd: Cmd) -> Result<(), String> {
             threads,
             force,
         } => {
-            let s = scene::Scene::load(&scene).map_err(|e| e.to_string())?;
-            trace::trace(
-                &s,
-                &trace::TraceArgs {
-                    photons,
-                    cache,
-                    threads,
-                    force,
-                },
-            )
-            .map(|_| ())
+            let s = load(&scene)?;
+            let overrides = Overrides {
+                photons,
+                ..Overrides::default()
+            };
+            pipeline::trace(&s, &overrides, &cache, threads, force).map(|_| ())
         }
     }
 }
 
-fn info(path: &PathBuf) -> Result<(), String> {
-    let s = scene::Scene::load(path).map_err(|e| e.to_string())?;
+fn info(path: &Path) -> Result<(), String> {
+    let s = load(path)?;
     let m = s.geometry.mesh();
     println!("scene      {} ({})", path.display(), s.file.name);
     println!("triangles  {}", m.len());

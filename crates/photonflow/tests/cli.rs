@@ -198,7 +198,9 @@ fn render_writes_exr_png_layers_and_json_identically_for_any_thread_count() {
     for key in [
         "\"spp\": 2",
         "\"samples_per_s\"",
-        "\"time_s\"",
+        "\"time_total_s\"",
+        "\"view_hash\"",
+        "\"count_kind\": \"spp\"",
         "\"scene_hash\"",
         "\"threads\": 1",
     ] {
@@ -235,7 +237,16 @@ fn swapping_the_estimator_reads_the_cache_and_never_traces() {
     let e = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{e}");
     assert!(e.contains("run `trace` first"), "{e}");
-    assert!(!cache.join("x").exists());
+    let photon_files = |dir: &std::path::Path| -> Vec<PathBuf> {
+        std::fs::read_dir(dir)
+            .map(|d| {
+                d.map(|e| e.unwrap().path())
+                    .filter(|p| p.extension().is_some_and(|x| x == "photons"))
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    assert!(photon_files(&cache).is_empty(), "estimate wrote photons");
 
     let o = photonflow(&["trace", scene, "--photons", "20000", "--cache", cache_s]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -244,11 +255,7 @@ fn swapping_the_estimator_reads_the_cache_and_never_traces() {
         text.contains("caustic photons: skipped"),
         "corner has no specular surface: {text}"
     );
-    let files: Vec<PathBuf> = std::fs::read_dir(&cache)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "photons"))
-        .collect();
+    let files = photon_files(&cache);
     assert_eq!(files.len(), 1, "only the global set: {files:?}");
     let before = std::fs::metadata(&files[0]).unwrap().modified().unwrap();
     let bytes = std::fs::read(&files[0]).unwrap();
@@ -364,9 +371,11 @@ fn render_without_a_method_runs_the_framework_standard_deterministically() {
         let text = String::from_utf8_lossy(&o.stdout);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         assert!(
-            text.contains("final-gather-4") && text.contains("irradiance cache"),
+            text.contains("rendered final-gather") && text.contains("irradiance cache"),
             "{text}"
         );
+        let json = std::fs::read_to_string(out.join("image.json")).unwrap();
+        assert!(json.contains("\"gather_rays\": 4"), "{json}");
         for layer in ["emitted", "direct", "caustic", "indirect"] {
             assert!(
                 out.join("layers").join(format!("{layer}.exr")).exists(),
@@ -376,6 +385,30 @@ fn render_without_a_method_runs_the_framework_standard_deterministically() {
         images.push(std::fs::read(out.join("image.exr")).unwrap());
     }
     assert_eq!(images[0], images[1], "1 and 2 threads give the same image");
+    // The resolved scene file in the output reproduces the run bit for bit, flags included
+    // (here --photons, --k and --gather-rays), from another working directory's view: its
+    // mesh paths are absolute.
+    let resolved = dir.0.join("1").join("scene.toml");
+    let text = std::fs::read_to_string(&resolved).unwrap();
+    assert!(
+        text.contains("photons = 20000") && text.contains("rays = 4"),
+        "{text}"
+    );
+    let again = dir.0.join("again");
+    let o = photonflow(&[
+        "render",
+        resolved.to_str().unwrap(),
+        "--cache",
+        cache.to_str().unwrap(),
+        "--out",
+        again.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        std::fs::read(again.join("image.exr")).unwrap(),
+        images[0],
+        "the resolved scene file reproduces the image"
+    );
 }
 
 #[test]
@@ -398,7 +431,10 @@ fn estimates_that_would_be_silently_wrong_are_refused() {
     ]);
     let e = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{e}");
-    assert!(e.contains("--boundary needs the topological test"), "{e}");
+    assert!(
+        e.contains("boundary correction needs the topological test"),
+        "{e}"
+    );
     // The path tracer is not an estimate.
     let o = photonflow(&["estimate", scene, "--method", "path", "--cache", cache_s]);
     assert_eq!(o.status.code(), Some(1));
@@ -430,4 +466,98 @@ fn estimates_that_would_be_silently_wrong_are_refused() {
         e.contains("store_direct = false") && e.contains("nodirect.toml"),
         "{e}"
     );
+}
+
+#[test]
+fn composite_averages_runs_by_their_counts_and_refuses_other_views() {
+    let dir = Scratch::new("composite", &[]);
+    let scene = "scenes/corner/corner.toml";
+    let mut outs = Vec::new();
+    for spp in ["1", "3"] {
+        let out = dir.0.join(spp);
+        let o = photonflow(&[
+            "render",
+            scene,
+            "--method",
+            "path",
+            "--spp",
+            spp,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        outs.push(out);
+    }
+    let out = dir.0.join("sum");
+    let o = photonflow(&[
+        "composite",
+        outs[1].to_str().unwrap(),
+        outs[0].to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let read = |d: &PathBuf| film::read_exr(d.join("image.exr")).unwrap();
+    let (a, b, c) = (read(&outs[0]), read(&outs[1]), read(&out));
+    // 1 spp and 3 spp weighted by their counts: the 4-spp mean, to f32 rounding per layer.
+    let mut worst = 0.0f64;
+    for ((x, y), z) in a.data.iter().zip(&b.data).zip(&c.data) {
+        for ch in 0..3 {
+            let want = (x[ch] as f64 + 3.0 * y[ch] as f64) / 4.0;
+            worst = worst.max((z[ch] as f64 - want).abs() / want.abs().max(1e-3));
+        }
+    }
+    assert!(worst < 1e-5, "relative error {worst}");
+    // In the other order: the same bytes.
+    let out2 = dir.0.join("sum2");
+    let o = photonflow(&[
+        "composite",
+        outs[0].to_str().unwrap(),
+        outs[1].to_str().unwrap(),
+        "--out",
+        out2.to_str().unwrap(),
+    ]);
+    assert!(o.status.success());
+    assert_eq!(
+        std::fs::read(out.join("image.exr")).unwrap(),
+        std::fs::read(out2.join("image.exr")).unwrap()
+    );
+    // Another camera is another view: refused, naming the input.
+    let obj = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/corner/corner.obj"
+    );
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/corner/corner.toml"
+    ))
+    .unwrap()
+    .replace("obj = \"corner.obj\"", &format!("obj = {obj:?}"))
+    .replace("vfov = 60.0", "vfov = 50.0");
+    let narrow = dir.0.join("narrow.toml");
+    std::fs::write(&narrow, text).unwrap();
+    let other = dir.0.join("other");
+    let o = photonflow(&[
+        "render",
+        narrow.to_str().unwrap(),
+        "--method",
+        "path",
+        "--spp",
+        "1",
+        "--out",
+        other.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let bad = dir.0.join("bad");
+    let o = photonflow(&[
+        "composite",
+        outs[0].to_str().unwrap(),
+        other.to_str().unwrap(),
+        "--out",
+        bad.to_str().unwrap(),
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains("view") && e.lines().count() == 1, "{e}");
+    assert!(!bad.exists(), "nothing written");
 }

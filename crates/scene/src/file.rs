@@ -83,12 +83,60 @@ pub struct RenderSettings {
     pub rr_depth: u32,
     /// Tile edge in pixels for parallel rendering (does not change the image).
     pub tile: u32,
-    /// What `render` does without `--method`: `final-gather` (the course framework's
-    /// standard: direct light + caustic map + final gathering into the global map),
-    /// `global-direct` (the global map shown directly) or `path` (the path-traced reference).
-    pub method: String,
-    /// Final-gather rays per pixel sample.
-    pub gather_rays: u32,
+    /// What `render` does without `--method` (see [`Method`]).
+    pub method: Method,
+    /// Whether the path tracer follows `L S+ D ...` paths (caustics); off leaves both caustic
+    /// layers out, so a caustic layer made by photons can be composited in their place.
+    pub caustics: bool,
+}
+
+/// How an image is made. The one place method names are spelled: the scene file, the
+/// command line (`--method`, parsed through serde) and every output's JSON use these.
+/// A photon method's knobs live in the scene file's `[estimate]` table.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// The path-traced reference (`render.spp`, `render.caustics`).
+    Path,
+    /// The global photon map shown directly at the first diffuse surface seen.
+    GlobalDirect,
+    /// The course framework's standard: direct light + caustic map + final gathering into
+    /// the global map.
+    #[default]
+    FinalGather,
+}
+
+impl Method {
+    /// Every method, in declaration order.
+    pub const ALL: [Method; 3] = [Method::Path, Method::GlobalDirect, Method::FinalGather];
+
+    /// The method's name as the scene file spells it.
+    pub fn name(self) -> String {
+        // A unit variant serialises to its name; serde is the one spelling.
+        match toml::Value::try_from(self) {
+            Ok(toml::Value::String(s)) => s,
+            _ => format!("{self:?}"),
+        }
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.name())
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Method, String> {
+        use serde::de::IntoDeserializer;
+        let de: serde::de::value::StrDeserializer<'_, serde::de::value::Error> =
+            s.into_deserializer();
+        Method::deserialize(de).map_err(|_| {
+            let known: Vec<String> = Method::ALL.iter().map(|m| m.name()).collect();
+            format!("unknown method `{s}` (known: {})", known.join(", "))
+        })
+    }
 }
 
 impl Default for RenderSettings {
@@ -98,8 +146,8 @@ impl Default for RenderSettings {
             max_depth: 64,
             rr_depth: 3,
             tile: 16,
-            method: "final-gather".into(),
-            gather_rays: 16,
+            method: Method::FinalGather,
+            caustics: true,
         }
     }
 }

@@ -1,8 +1,9 @@
 //! `scene`: turns a scene file into a ready-to-trace [`Scene`].
 //!
-//! Key decision: **one TOML file holds every parameter of a run** (Tungsten's habit, style
-//! anchor A3): mesh files and their transforms, spheres, materials, camera, seed and render
-//! settings. Its keys are the `snake_case` names of the Rust fields (anchor A2.4) and unknown
+//! Key decision: **one TOML file holds every parameter of a run** (Tungsten's habit: one
+//! JSON scene file per render): mesh files and their transforms, spheres, materials, camera,
+//! seed and render settings. Its keys are the `snake_case` names of the Rust fields (as
+//! Mitsuba 3's scene keys are its plugin parameters' names) and unknown
 //! keys are errors, so a typo never silently falls back to a default.
 //!
 //! Loading never panics: every problem is a [`SceneError`] naming the file and what is wrong
@@ -20,8 +21,8 @@ mod world;
 pub use camera::Camera;
 pub use error::SceneError;
 pub use file::{
-    CameraDesc, EmissionSource, MaterialDesc, MeshDesc, NormalMode, RenderSettings, SceneFile,
-    SphereDesc,
+    CameraDesc, EmissionSource, MaterialDesc, MeshDesc, Method, NormalMode, RenderSettings,
+    SceneFile, SphereDesc,
 };
 pub use lights::{Emitted, LightPoint, LightSample, LightTable};
 pub use load::{AreaLight, Scene, fnv1a64};

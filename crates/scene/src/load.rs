@@ -46,6 +46,10 @@ pub struct Scene {
     pub photon_hash: u64,
     /// `photon_hash` plus the camera and `[render]`: what a path-traced image depends on.
     pub image_hash: u64,
+    /// What an image *means*: the named files, meshes, spheres, materials and camera, but not
+    /// the seed or any sampling setting. Images with equal view hashes estimate the same
+    /// picture and may be composited.
+    pub view_hash: u64,
 }
 
 impl Scene {
@@ -97,7 +101,7 @@ impl Scene {
         let mut hash = Fnv::new();
         let mut scene = Builder::new(path, &file, &mut hash).build(file.clone())?;
         let files = hash.finish();
-        let inputs = |f: &SceneFile, camera: bool| -> String {
+        let inputs = |f: &SceneFile, camera: bool, seed: bool, render: bool| -> String {
             #[derive(serde::Serialize)]
             struct Inputs<'a> {
                 files: u64,
@@ -108,19 +112,30 @@ impl Scene {
                 camera: Option<&'a crate::CameraDesc>,
                 render: Option<&'a RenderSettings>,
             }
+            // Mesh files count by content (`files`), not by the path that names them, so a
+            // resolved scene file with absolute paths keeps its caches.
+            let meshes: Vec<crate::MeshDesc> = f
+                .meshes
+                .iter()
+                .map(|m| crate::MeshDesc {
+                    obj: String::new(),
+                    ..m.clone()
+                })
+                .collect();
             toml::to_string(&Inputs {
                 files,
-                seed: f.seed,
-                meshes: &f.meshes,
+                seed: if seed { f.seed } else { 0 },
+                meshes: &meshes,
                 spheres: &f.spheres,
                 materials: &f.materials,
                 camera: camera.then_some(&f.camera),
-                render: camera.then_some(&f.render),
+                render: render.then_some(&f.render),
             })
             .unwrap_or_default()
         };
-        scene.photon_hash = fnv1a64(inputs(&file, false).as_bytes());
-        scene.image_hash = fnv1a64(inputs(&file, true).as_bytes());
+        scene.photon_hash = fnv1a64(inputs(&file, false, true, false).as_bytes());
+        scene.image_hash = fnv1a64(inputs(&file, true, true, true).as_bytes());
+        scene.view_hash = fnv1a64(inputs(&file, true, false, false).as_bytes());
         let mut all = Fnv::new();
         all.write(&files.to_le_bytes());
         all.write(text.as_bytes());
@@ -262,15 +277,6 @@ impl<'a> Builder<'a> {
         if r.spp == 0 || r.spp > 1 << 24 {
             return Err(self.err(format!("render.spp = {} must be in 1..=16777216", r.spp)));
         }
-        if !["final-gather", "global-direct", "path"].contains(&r.method.as_str()) {
-            return Err(self.err(format!(
-                "render.method = \"{}\" is not one of final-gather, global-direct, path",
-                r.method
-            )));
-        }
-        if r.gather_rays > 1 << 16 {
-            return Err(self.err(format!("render.gather_rays = {} is absurd", r.gather_rays)));
-        }
         if r.tile == 0 || r.tile > 4096 {
             return Err(self.err(format!("render.tile = {} must be in 1..=4096", r.tile)));
         }
@@ -357,6 +363,7 @@ impl<'a> Builder<'a> {
             content_hash: 0,
             photon_hash: 0,
             image_hash: 0,
+            view_hash: 0,
         })
     }
 
@@ -396,7 +403,6 @@ impl<'a> Builder<'a> {
                 ),
             )
         })?;
-        self.hash.write(desc.obj.as_bytes());
         self.hash.write(&bytes);
 
         // tobj asks for MTL files by the name in `mtllib`; read them ourselves so a missing or

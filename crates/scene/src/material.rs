@@ -2,7 +2,7 @@ use glam::Vec3;
 
 /// What a surface does with light. Plain data: the eye and photon passes turn it into BSDFs.
 ///
-/// MTL mapping (scene-facts.md; `load.rs` applies it): `Kd` → [`Material::Lambertian`];
+/// MTL mapping (the course framework's conventions; `load.rs` applies it): `Kd` → [`Material::Lambertian`];
 /// `illum 3` → [`Material::Mirror`] with `Ks`; `illum 4`, `6`, `7`, or `Ni > 1` on a
 /// transparent (`d < 1`) material → [`Material::Dielectric`] with `Ni`; `illum 11` →
 /// [`Material::Metal`] with reflectance `Ks` (the course's constant-reflectance model).

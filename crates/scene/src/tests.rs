@@ -1,4 +1,5 @@
-//! Scene loading against the numbers of scene-facts.md, and every kind of bad input.
+//! Scene loading against the course worksheet's numbers for its scene (restated in each
+//! test), and every kind of bad input.
 
 use crate::{Material, Scene};
 use glam::Vec3;
@@ -79,7 +80,7 @@ fn analytic_cornell_matches_the_worksheet_scene() {
         Vec3::new(-10.505, 2.2907, -9.2368),
         1e-4
     ));
-    // scene-facts gives 2.2901 for 0.025 * 91.60 = 2.29: rounding in the source.
+    // The worksheet gives 2.2901 for 0.025 * 91.60 = 2.29: rounding in the source.
     assert!(close(
         sp[1].center,
         Vec3::new(-3.2720, 2.2901, -6.2395),

@@ -1,6 +1,6 @@
 //! Throughput of the photon file and of the encodings it could have used, for
-//! `cargo xtask bench store`. Run it in release; the numbers quoted in the crate doc come from
-//! here. Timings are wall clock and only reported, never asserted.
+//! `cargo xtask bench store`, which records its output in `docs/benchmarks.md`. Timings are
+//! wall clock and only reported, never asserted.
 //!
 //! All rates are in GB/s (1e9 bytes) of *records*, 32 bytes per photon, whatever the encoding's
 //! own size, so the rates compare directly.

@@ -120,8 +120,9 @@ impl StoreReader {
 /// copy and no decoding.
 ///
 /// `open` verifies every chunk's checksum once, which reads the whole file: CRC-32 with
-/// PCLMULQDQ ran at 20 - 50 GB/s here, a few ms per 100 MB (see `bench`), and the map is then
-/// trusted. The map is populated (`MAP_POPULATE`) since that pass touches every page anyway.
+/// PCLMULQDQ runs several times faster than the mapped read as a whole (`docs/benchmarks.md`,
+/// bench store), so this costs little, and the map is then trusted. The map is populated
+/// (`MAP_POPULATE`) since that pass touches every page anyway.
 pub struct MappedStore {
     path: PathBuf,
     map: memmap2::Mmap,

@@ -11,6 +11,53 @@ pub enum MapKind {
     Caustic = 2,
 }
 
+impl MapKind {
+    /// Every kind, in slot order.
+    pub const ALL: [MapKind; 2] = [MapKind::Global, MapKind::Caustic];
+
+    /// Position in [`MapKind::ALL`] and in a [`PerKind`].
+    pub const fn slot(self) -> usize {
+        self as usize - 1
+    }
+
+    /// Lower-case name, as in cache file names and messages.
+    pub const fn name(self) -> &'static str {
+        match self {
+            MapKind::Global => "global",
+            MapKind::Caustic => "caustic",
+        }
+    }
+}
+
+/// One value per photon map kind, indexed by [`MapKind`]: photon sets are keyed by kind, so
+/// a new kind is one enum arm, not a new field in every struct that carries sets.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PerKind<T>(pub [T; 2]);
+
+impl<T> PerKind<T> {
+    /// `(kind, value)` in slot order.
+    pub fn iter(&self) -> impl Iterator<Item = (MapKind, &T)> {
+        MapKind::ALL.into_iter().zip(self.0.iter())
+    }
+
+    pub fn map<U>(self, f: impl FnMut(T) -> U) -> PerKind<U> {
+        PerKind(self.0.map(f))
+    }
+}
+
+impl<T> std::ops::Index<MapKind> for PerKind<T> {
+    type Output = T;
+    fn index(&self, k: MapKind) -> &T {
+        &self.0[k.slot()]
+    }
+}
+
+impl<T> std::ops::IndexMut<MapKind> for PerKind<T> {
+    fn index_mut(&mut self, k: MapKind) -> &mut T {
+        &mut self.0[k.slot()]
+    }
+}
+
 /// One stored photon: 32 bytes, `#[repr(C)]` with no padding, so a file's payload is read by
 /// casting bytes (bytemuck) instead of decoding them.
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]

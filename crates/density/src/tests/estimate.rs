@@ -40,7 +40,6 @@ fn each_estimator_matches_uniform_irradiance_or_its_predicted_bias() {
         let mut rng = Rng::for_index(2012, rep);
         let map = PhotonMap::build(
             floor_photons(n, 0.0, 1.0, 0.0, 1.0, &mut rng),
-            1,
             IndexKind::KdTree,
         );
         let mut sums = vec![0.0f64; means.len()];
@@ -99,6 +98,57 @@ fn each_estimator_matches_uniform_irradiance_or_its_predicted_bias() {
         "{report}"
     );
     assert!((dropped - 1.0).abs() < 0.004, "{report}");
+    eprintln!("{report}");
+}
+
+/// The fixed-radius estimate on a uniform plane: with r fixed, the photons in the disc are
+/// a Poisson-like sample of it and none sits on the boundary by construction, so
+/// E[(1/r²) Σ Φ K(d/r)] = λ Φ ∫K exactly (no k-NN boundary term): E0 for every kernel
+/// normalised to 1, and 0.531 E0 for Jensen's original Gaussian. Replicates (independent
+/// photon sets) give the standard error.
+#[test]
+fn fixed_radius_irradiance_of_a_uniform_plane_is_unbiased() {
+    let (n, reps, queries, r) = (20_000, 48, 200, 0.05f32);
+    // Every photon carries 1/n of a total flux of 1 on the unit square: E0 = 1.
+    let photon_flux = 1.0 / n as f32;
+    let kernels = Kernel::ALL;
+    let mut means = vec![Vec::new(); kernels.len()];
+    let mut scratch = Vec::new();
+    for rep in 0..reps {
+        let mut rng = Rng::for_index(1999, rep);
+        let photons = floor_photons(n, 0.0, 1.0, 0.0, 1.0, &mut rng)
+            .into_iter()
+            .map(|p| Photon::new(p.position(), Vec3::splat(photon_flux), p.direction(), 0))
+            .collect();
+        let map = PhotonMap::build(photons, IndexKind::KdTree);
+        let mut sums = vec![0.0f64; kernels.len()];
+        for _ in 0..queries {
+            // A margin of 2r keeps every disc on the plane.
+            let x = Vec3::new(0.1 + 0.8 * rng.uniform(), 0.0, 0.1 + 0.8 * rng.uniform());
+            for (sum, &kernel) in sums.iter_mut().zip(&kernels) {
+                let p = EstimateParams {
+                    kernel,
+                    ..Default::default()
+                };
+                *sum += map.irradiance_within(x, Vec3::Y, r, &p, &mut scratch).x as f64;
+            }
+        }
+        for (m, s) in means.iter_mut().zip(sums) {
+            m.push(s / queries as f64);
+        }
+    }
+    let mut report = String::new();
+    for (m, &kernel) in means.iter().zip(&kernels) {
+        let want = if kernel == Kernel::GaussianJensen {
+            crate::jensen_gaussian_mass()
+        } else {
+            1.0
+        };
+        let (mean, se) = mean_se(m);
+        report += &format!("{kernel:?}: {mean:.5} ± {se:.5} (expected {want:.5})\n");
+        assert!(se < 0.005, "standard error too large:\n{report}");
+        assert!((mean - want).abs() < 4.0 * se, "{report}");
+    }
     eprintln!("{report}");
 }
 
@@ -170,13 +220,22 @@ fn topological_test_removes_the_corner_leak() {
             let p = Vec3::new(0.0, 0.5 * rng.uniform(), 2.0 * rng.uniform());
             Photon::new(p, Vec3::ONE, wall_dir, 1)
         }));
-        let map = PhotonMap::build(photons, 1, IndexKind::KdTree);
+        let map = PhotonMap::build(photons, IndexKind::KdTree);
         let (mut sp, mut st) = (0.0, 0.0);
         let zs: Vec<f32> = (0..171).map(|i| 0.15 + 0.01 * i as f32).collect();
         for &z in &zs {
             let x = Vec3::new(d as f32, 0.0, z);
-            sp += map.irradiance(x, Vec3::Y, &plain, &mut scratch).x as f64;
-            st += map.irradiance(x, Vec3::Y, &topo, &mut scratch).x as f64;
+            let (ep, et) = (
+                map.irradiance(x, Vec3::Y, &plain, &mut scratch),
+                map.irradiance(x, Vec3::Y, &topo, &mut scratch),
+            );
+            // The fixed-radius estimate applies the same tests.
+            for (e, p) in [(ep, &plain), (et, &topo)] {
+                let w = map.irradiance_within(x, Vec3::Y, r as f32, p, &mut scratch);
+                assert_eq!(w, e, "{p:?}");
+            }
+            sp += ep.x as f64;
+            st += et.x as f64;
         }
         plain_means.push(sp / zs.len() as f64);
         topo_means.push(st / zs.len() as f64);
@@ -206,14 +265,19 @@ each_index!(
     more_k_than_photons_uses_r_max_or_the_farthest,
     |kind: IndexKind| {
         let mut rng = Rng::new(5);
-        let map = PhotonMap::build(floor_photons(10, -0.5, 1.0, -0.5, 1.0, &mut rng), 4, kind);
+        // Ten photons traced from 4 emitted paths: each stores 1/4 of its path's flux 1.
+        let photons = floor_photons(10, -0.5, 1.0, -0.5, 1.0, &mut rng)
+            .into_iter()
+            .map(|p| Photon::new(p.position(), p.power() / 4.0, p.direction(), 0))
+            .collect();
+        let map = PhotonMap::build(photons, kind);
         let mut s = Vec::new();
         let p = EstimateParams {
             k: 50,
             r_max: 2.0,
             ..Default::default()
         };
-        // All 10 within r_max = 2: E = 10 Φ / (π 2²) / emitted.
+        // All 10 within r_max = 2: E = 10 Φ / (π 2²), Φ = 1/4.
         let e = map.irradiance(Vec3::ZERO, Vec3::Y, &p, &mut s);
         assert_eq!(s.len(), 10);
         assert!((e.x as f64 - 10.0 / (PI * 4.0) / 4.0).abs() < 1e-6, "{e}");
@@ -246,8 +310,8 @@ each_index!(
 
 each_index!(degenerate_inputs_give_zero_not_nan, |kind: IndexKind| {
     let mut rng = Rng::new(6);
-    let map = PhotonMap::build(floor_photons(100, 0.0, 1.0, 0.0, 1.0, &mut rng), 1, kind);
-    let empty = PhotonMap::build(Vec::new(), 0, kind);
+    let map = PhotonMap::build(floor_photons(100, 0.0, 1.0, 0.0, 1.0, &mut rng), kind);
+    let empty = PhotonMap::build(Vec::new(), kind);
     let mut s = Vec::new();
     let p = EstimateParams::default();
     let x = Vec3::new(0.5, 0.0, 0.5);
@@ -280,12 +344,27 @@ each_index!(degenerate_inputs_give_zero_not_nan, |kind: IndexKind| {
     // A NaN query point finds nothing.
     assert_eq!(map.irradiance(Vec3::NAN, Vec3::Y, &p, &mut s), Vec3::ZERO);
     assert!(map.irradiance(x, Vec3::Y, &p, &mut s).x > 0.0);
+    // Fixed radius: no bandwidth, an infinite or invalid one, nothing inside, no photons.
+    for r in [0.0, -0.5, f32::NAN, f32::INFINITY] {
+        assert_eq!(map.irradiance_within(x, Vec3::Y, r, &p, &mut s), Vec3::ZERO);
+        assert!(s.is_empty(), "r={r}");
+    }
+    let within =
+        |m: &PhotonMap, x: Vec3, n: Vec3, s: &mut Vec<_>| m.irradiance_within(x, n, 0.1, &p, s);
+    assert_eq!(
+        within(&map, Vec3::new(5.0, 0.0, 5.0), Vec3::Y, &mut s),
+        Vec3::ZERO
+    );
+    assert_eq!(within(&empty, x, Vec3::Y, &mut s), Vec3::ZERO);
+    assert_eq!(within(&map, Vec3::NAN, Vec3::Y, &mut s), Vec3::ZERO);
+    assert_eq!(within(&map, x, -Vec3::Y, &mut s), Vec3::ZERO);
+    assert!(within(&map, x, Vec3::Y, &mut s).x > 0.0);
 });
 
 each_index!(all_photons_at_one_point, |kind: IndexKind| {
     let at = Vec3::new(1.0, 0.0, 1.0);
     let photons = vec![Photon::new(at, Vec3::ONE, -Vec3::Y, 0); 500];
-    let map = PhotonMap::build(photons, 1, kind);
+    let map = PhotonMap::build(photons, kind);
     let mut s = Vec::new();
     for kernel in Kernel::ALL {
         for drop_kth in [false, true] {
@@ -344,7 +423,7 @@ each_index!(scene_scale_does_not_change_irradiance, |kind: IndexKind| {
                 )
             })
             .collect();
-        PhotonMap::build(photons, 1, kind)
+        PhotonMap::build(photons, kind)
     };
     let reference = scaled(1.0);
     let mut s = Vec::new();
@@ -411,7 +490,7 @@ each_index!(hinted_irradiance_is_bit_identical, |kind: IndexKind| {
         let p = Vec3::new(0.5, 1e-4 * (i % 5) as f32, 0.5);
         Photon::new(p, Vec3::ONE, -Vec3::Y, 0)
     }));
-    let map = PhotonMap::build(photons, 3, kind);
+    let map = PhotonMap::build(photons, kind);
     let mut s = Vec::new();
     let mut plain = Vec::new();
     let params: Vec<EstimateParams> = [1, 50, 250]
@@ -471,3 +550,63 @@ each_index!(hinted_irradiance_is_bit_identical, |kind: IndexKind| {
         }
     }
 });
+
+// The fixed-radius estimate is the k-NN estimate whose k is never reached and whose r_max
+// is the radius, bit for bit, for every kernel and test: same photons, same index order,
+// same sums. Photons on a cube's faces with random directions and a dense clump.
+each_index!(
+    fixed_radius_irradiance_is_the_knn_estimate_with_k_unbounded,
+    |kind: IndexKind| {
+        let mut rng = Rng::new(31);
+        let mut photons: Vec<Photon> = (0..6000)
+            .map(|i| {
+                let p = Vec3::from(crate::bench::point_on_unit_cube(&mut rng));
+                let dir = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5;
+                Photon::new(p, Vec3::new(1.0, 0.5, 0.25) * (1.0 + rng.uniform()), dir, i)
+            })
+            .collect();
+        photons.extend((0..100).map(|i| {
+            let p = Vec3::new(0.5, 1e-4 * (i % 5) as f32, 0.5);
+            Photon::new(p, Vec3::ONE, -Vec3::Y, 0)
+        }));
+        let map = PhotonMap::build(photons, kind);
+        let (mut s, mut knn) = (Vec::new(), Vec::new());
+        let mut nonzero = 0;
+        for i in 0..60 {
+            let x = match i % 3 {
+                0 => Vec3::from(crate::bench::point_on_unit_cube(&mut rng)),
+                1 => Vec3::new(0.5, 0.0, 0.5),
+                _ => Vec3::new(rng.uniform(), 0.0, rng.uniform()),
+            };
+            for kernel in Kernel::ALL {
+                for (same_side, topo) in [(true, None), (false, Some(0.2)), (true, Some(0.05))] {
+                    for r in [0.01f32, 0.06, 0.3] {
+                        let p = EstimateParams {
+                            kernel,
+                            same_side,
+                            topo,
+                            ..Default::default()
+                        };
+                        let e = map.irradiance_within(x, Vec3::Y, r, &p, &mut s);
+                        let unbounded = EstimateParams {
+                            k: usize::MAX,
+                            r_max: r,
+                            ..p
+                        };
+                        let want = map.irradiance(x, Vec3::Y, &unbounded, &mut knn);
+                        let what = format!("{} x={x} r={r} {p:?}", kind.name());
+                        assert_eq!(s, knn, "{what}");
+                        assert_eq!(
+                            e.to_array().map(f32::to_bits),
+                            want.to_array().map(f32::to_bits),
+                            "{what}"
+                        );
+                        nonzero += (e.x > 0.0) as usize;
+                    }
+                }
+            }
+        }
+        // Not vacuous: most estimates see photons.
+        assert!(nonzero > 60 * 7 * 9 / 2, "{nonzero}");
+    }
+);

@@ -1,6 +1,6 @@
 use super::*;
 use crate::index::dist2;
-use crate::{Index, KnnHint, Neighbor, PhotonMap};
+use crate::{Index, KnnHint, MapPhoton, Neighbor, PhotonMap};
 use glam::Vec3;
 use math::Rng;
 use store::Photon;
@@ -134,22 +134,159 @@ each_index!(
         let photons: Vec<Photon> = (0..2000)
             .map(|i| {
                 let p = Vec3::from(crate::bench::point_on_unit_cube(&mut rng));
-                Photon::new(p, Vec3::splat(i as f32), -Vec3::Y, i)
+                let dir = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5;
+                Photon::new(p, Vec3::splat(i as f32), dir, i)
             })
             .collect();
-        let map = PhotonMap::build(photons.clone(), 1, kind);
+        let map = PhotonMap::build(photons.clone(), kind);
+        assert_eq!(map.len(), photons.len());
+        // As given, each field from its own slot: the surface id names the photon given.
+        let given = |i: usize| {
+            let p = &photons[map.surface(i) as usize];
+            MapPhoton {
+                position: p.position(),
+                direction: p.direction(),
+                power: p.power(),
+                surface: p.surface,
+            }
+        };
         let mut out = Vec::new();
-        let q = Vec3::new(0.3, 0.0, 0.6);
-        map.knn(q, 20, f32::INFINITY, &mut out);
-        assert_eq!(out.len(), 20);
-        for nb in &out {
-            let ph = &map.photons()[nb.index as usize];
-            assert_eq!(dist2(ph.pos, q.to_array()), nb.d2);
-            // The record moved as a whole: its power still names its original slot.
-            assert_eq!(photons[ph.surface as usize], *ph);
+        for (q, r) in [
+            (Vec3::new(0.3, 0.0, 0.6), 0.2),
+            (Vec3::new(1.0, 0.5, 0.5), 0.2),
+        ] {
+            map.knn(q, 20, f32::INFINITY, &mut out);
+            assert_eq!(out.len(), 20);
+            let mut found = out.clone();
+            map.within(q, r, &mut out);
+            assert!(out.len() > 20, "{}", out.len());
+            found.extend_from_slice(&out);
+            for nb in &found {
+                let i = nb.index as usize;
+                assert_eq!(dist2(map.position(i).to_array(), q.to_array()), nb.d2);
+                assert_eq!(map.photon(i), given(i));
+            }
+        }
+        // The iterator walks map order and holds every photon once.
+        assert_eq!(map.iter().len(), map.len());
+        let mut surfaces = Vec::new();
+        for (i, p) in map.iter().enumerate() {
+            assert_eq!(p, map.photon(i));
+            assert_eq!(p, given(i));
+            surfaces.push(p.surface);
+        }
+        surfaces.sort_unstable();
+        assert!(surfaces.iter().copied().eq(0..photons.len() as u32));
+    }
+);
+
+/// [`Index::within`] returns exactly the oracle's points in `(d2, index)` order, and the
+/// estimate's index-order variant the same set by index.
+fn check_within(index: &Index, points: &[[f32; 3]], q: Vec3, r: f32, out: &mut Vec<Neighbor>) {
+    let what = format!("{} n={} q={q} r={r}", index.kind().name(), points.len());
+    let want = reference(points, q, usize::MAX, r);
+    index.within(q, r, out);
+    assert_eq!(*out, want, "{what}");
+    index.within_in_index_order(q, r, out);
+    let mut by_index = want;
+    by_index.sort_by_key(|n| n.index);
+    assert_eq!(*out, by_index, "{what} (index order)");
+}
+
+/// Radii for `within`: zero (exact hits only), tiny, the scale of the points, grid
+/// distances (exact ties), one whose square overflows, infinite, and invalid ones.
+const RADII: [f32; 11] = [
+    0.0,
+    1e-3,
+    0.2,
+    0.45,
+    1.0,
+    std::f32::consts::SQRT_2,
+    1e30,
+    f32::MAX,
+    f32::INFINITY,
+    -1.0,
+    f32::NAN,
+];
+
+each_index!(
+    within_equals_brute_force_for_every_n_up_to_64,
+    |kind: IndexKind| {
+        let mut out = Vec::new();
+        for n in 0..=64usize {
+            let mut rng = Rng::for_index(27, n as u64);
+            for (points, lo, step) in [
+                (grid_points(n, &mut rng), -0.5f32, 1.3f32),
+                (random_points(n, &mut rng), -0.25, 0.5),
+            ] {
+                let index = Index::build(kind, &points);
+                for i in 0..64 {
+                    let q = Vec3::new(
+                        lo + step * (i % 4) as f32,
+                        lo + step * (i / 4 % 4) as f32,
+                        lo + step * (i / 16) as f32,
+                    );
+                    for r in RADII
+                        .into_iter()
+                        .chain([rng.uniform(), 3.0 * rng.uniform()])
+                    {
+                        check_within(&index, &points, q, r, &mut out);
+                    }
+                }
+                // On the points themselves: exact hits, and grid neighbours at exactly r.
+                for &p in points.iter().take(8) {
+                    for r in [0.0, 1.0, rng.uniform()] {
+                        check_within(&index, &points, Vec3::from(p), r, &mut out);
+                    }
+                }
+                check_within(&index, &points, Vec3::NAN, f32::INFINITY, &mut out);
+            }
         }
     }
 );
+
+each_index!(
+    within_equals_brute_force_on_10k_photons,
+    |kind: IndexKind| {
+        let mut rng = Rng::new(13);
+        let mut points: Vec<[f32; 3]> = (0..10_000)
+            .map(|_| crate::bench::point_on_unit_cube(&mut rng))
+            .collect();
+        // Exact duplicates and a dense clump.
+        points.extend_from_within(0..50);
+        points.extend((0..200).map(|i| [0.5, 0.5, 1e-4 * (i % 7) as f32]));
+        let index = Index::build(kind, &points);
+        let mut out = Vec::new();
+        for i in 0..100 {
+            let q = match i % 4 {
+                0 => Vec3::new(0.5, 0.5, 0.0),
+                1 => Vec3::from(points[rng.below(points.len() as u32) as usize]),
+                2 => Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 1.2 - 0.1,
+                _ => Vec3::from(crate::bench::point_on_unit_cube(&mut rng)),
+            };
+            for r in [0.0, 0.2 * rng.uniform(), 0.02 * rng.uniform(), 1e-4] {
+                check_within(&index, &points, q, r, &mut out);
+            }
+        }
+        // Everything, once.
+        check_within(&index, &points, Vec3::splat(0.5), 2.0, &mut out);
+        assert_eq!(out.len(), points.len());
+    }
+);
+
+each_index!(within_an_empty_index_finds_nothing, |kind: IndexKind| {
+    let index = Index::build(kind, &[]);
+    assert!(index.is_empty());
+    // A stale result must not survive the call.
+    let mut out = vec![Neighbor { index: 7, d2: 1.0 }; 3];
+    for r in RADII {
+        for q in [Vec3::ZERO, Vec3::NAN] {
+            index.within(q, r, &mut out);
+            assert!(out.is_empty(), "r={r} q={q}");
+            out.push(Neighbor { index: 7, d2: 1.0 });
+        }
+    }
+});
 
 /// Radius guesses for `knn_hinted`: none, useless, too small, about right, too large.
 fn hints(at: Vec3, r: f32) -> [KnnHint; 10] {

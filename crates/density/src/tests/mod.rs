@@ -1,11 +1,14 @@
 //! Unit tests of `density`, one module per concern:
-//! - `knn`: every index equals brute force, exhaustively for small inputs;
+//! - `knn`: every index equals brute force (k-NN and fixed radius), exhaustively for small
+//!   inputs;
 //! - `kernel`: each kernel integrates to 1 over the unit disc; Jensen's Gaussian to 0.531;
-//! - `estimate`: bias on a uniform plane, the corner leak, robustness.
+//! - `estimate`: bias on a uniform plane (k-NN and fixed radius), the corner leak,
+//!   robustness.
 
 use crate::IndexKind;
 
-/// Runs one case under every index back-end (anchor B1.6, ripgrep's `rgtest!`):
+/// Runs one case under every index back-end (as ripgrep's `rgtest!` runs each case under
+/// every regex engine):
 /// `each_index!(name, |kind: IndexKind| { ... });` makes `name::{kd_tree, kiddo, brute}`.
 macro_rules! each_index {
     ($name:ident, $case:expr) => {
@@ -39,7 +42,22 @@ fn mean_se(xs: &[f64]) -> (f64, f64) {
     (mean, (var / n).sqrt())
 }
 
+/// `IndexKind::ALL` is what the tests and benchmarks iterate: each entry must build its own
+/// back-end, and its name must be distinct and be what parameter files spell (serde).
 #[test]
-fn index_kinds_are_all_listed() {
-    assert_eq!(IndexKind::ALL.len(), 3);
+fn each_index_kind_builds_itself_under_its_own_name() {
+    #[derive(serde::Deserialize)]
+    struct File {
+        index: IndexKind,
+    }
+    let mut names = Vec::new();
+    for kind in IndexKind::ALL {
+        let index = crate::Index::build(kind, &[[0.0, 1.0, 2.0]]);
+        assert_eq!(index.kind(), kind);
+        assert_eq!(index.len(), 1, "{kind:?}");
+        let file: File = toml::from_str(&format!("index = \"{}\"", kind.name())).unwrap();
+        assert_eq!(file.index, kind, "{kind:?} is not spelled {}", kind.name());
+        assert!(!names.contains(&kind.name()), "{} twice", kind.name());
+        names.push(kind.name());
+    }
 }

@@ -4,7 +4,7 @@
 //! surface facing the same way. Final gathering averages many such lookups, which hides the
 //! piecewise-constant approximation; a k = 1000 estimate per gather ray would cost ~50x more.
 
-use density::{Index, IndexKind, KnnHint, Neighbor, PhotonMap};
+use density::{Index, IndexKind, KnnHint, MapPhoton, Neighbor, PhotonMap};
 use glam::Vec3;
 use rayon::prelude::*;
 use scene::Scene;
@@ -24,9 +24,9 @@ pub type Estimator<'a> =
     dyn Fn(Vec3, Vec3, &mut KnnHint, &mut Vec<Neighbor>) -> (Vec3, f32) + Sync + 'a;
 
 /// Unit normal of the surface a photon landed on, turned towards the side it arrived from.
-fn photon_normal(scene: &Scene, p: &store::Photon) -> Option<Vec3> {
-    let n = scene.surface_normal(p.surface, p.position())?;
-    Some(if n.dot(p.direction()) > 0.0 { -n } else { n })
+fn photon_normal(scene: &Scene, p: &MapPhoton) -> Option<Vec3> {
+    let n = scene.surface_normal(p.surface, p.position)?;
+    Some(if n.dot(p.direction) > 0.0 { -n } else { n })
 }
 
 impl IrradianceCache {
@@ -40,11 +40,10 @@ impl IrradianceCache {
         estimate: &Estimator,
     ) -> Self {
         let picked: Vec<(Vec3, Vec3)> = map
-            .map(|m| m.photons())
-            .unwrap_or_default()
-            .iter()
+            .into_iter()
+            .flat_map(|m| m.iter())
             .step_by(stride.max(1))
-            .filter_map(|p| Some((p.position(), photon_normal(scene, p)?)))
+            .filter_map(|p| Some((p.position, photon_normal(scene, &p)?)))
             .collect();
         let values: Vec<(Vec3, f32)> = picked
             .par_chunks(1024)
@@ -68,6 +67,10 @@ impl IrradianceCache {
 
     pub fn len(&self) -> usize {
         self.irradiance.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.irradiance.is_empty()
     }
 
     /// Irradiance of the nearest precomputed point (among the 8 nearest) whose normal is

@@ -4,8 +4,8 @@
 //! reference (whole image, and the band along the box's inner edges where topological bias
 //! lives); and writes a Markdown summary beside the images.
 
-use crate::estimate::{self, EstimateArgs, kernel_name};
-use crate::render::{self, RenderArgs};
+use crate::settings::kernel_name;
+use crate::{Overrides, Photons, RenderRequest};
 use density::Kernel;
 use film::{Image, Mask};
 use glam::Vec3;
@@ -33,8 +33,7 @@ struct Variant {
     explain: &'static str,
 }
 
-pub fn run(a: &WorksheetArgs) -> Result<(), String> {
-    let scene = Scene::load(&a.scene).map_err(|e| e.to_string())?;
+pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
     std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
 
     // 1. The path-traced reference, reused when it was made from this scene at >= the spp.
@@ -51,14 +50,23 @@ pub fn run(a: &WorksheetArgs) -> Result<(), String> {
         println!("reference: reusing {}", ref_dir.display());
     } else {
         println!("reference: path tracing at {} spp", a.reference_spp);
-        render::path(RenderArgs {
-            scene: a.scene.clone(),
-            spp: Some(a.reference_spp),
-            no_caustics: false,
-            threads: a.threads,
-            out: Some(ref_dir.clone()),
-            exposure: 0.0,
-        })?;
+        crate::render(
+            scene,
+            &RenderRequest {
+                overrides: Overrides {
+                    method: Some(scene::Method::Path),
+                    spp: Some(a.reference_spp),
+                    ..Overrides::default()
+                },
+                cache: &a.cache,
+                photons: Photons::CacheOnly,
+                threads: a.threads,
+                out: Some(ref_dir.clone()),
+                exposure: 0.0,
+                reference: None,
+                label: None,
+            },
+        )?;
     }
     let reference = film::read_exr(ref_dir.join("image.exr")).map_err(|e| e.to_string())?;
     let ref_meta: serde_json::Value = std::fs::read_to_string(&reference_json)
@@ -67,15 +75,11 @@ pub fn run(a: &WorksheetArgs) -> Result<(), String> {
         .unwrap_or_default();
 
     // 2. One photon set for every estimate.
-    let t = crate::trace::trace(
-        &scene,
-        &crate::trace::TraceArgs {
-            photons: Some(a.photons),
-            cache: a.cache.clone(),
-            threads: a.threads,
-            force: false,
-        },
-    )?;
+    let photons = Overrides {
+        photons: Some(a.photons),
+        ..Overrides::default()
+    };
+    let t = crate::trace(scene, &photons, &a.cache, a.threads, false)?;
 
     // 3. The estimates.
     let variants = [
@@ -140,7 +144,7 @@ pub fn run(a: &WorksheetArgs) -> Result<(), String> {
         },
     ];
     let (w, h) = (reference.width, reference.height);
-    let edges = edge_mask(&scene, 0.4);
+    let edges = edge_mask(scene, 0.4);
     // Metrics at 1/DOWN resolution: each compared pixel then averages DOWN^2 reference
     // pixels, so the reference's fireflies (caustic paths the path tracer finds rarely) stop
     // dominating every RMSE.
@@ -154,24 +158,27 @@ pub fn run(a: &WorksheetArgs) -> Result<(), String> {
     let mut rows = Vec::new();
     for v in &variants {
         let out = a.out.join(v.name);
-        let e = estimate::estimate(
-            &scene,
-            &EstimateArgs {
-                method: eye::PhotonMethod::GlobalDirect,
-                photons: Some(a.photons),
-                cache: a.cache.clone(),
-                spp: Some(1),
+        let reference_exr = ref_dir.join("image.exr");
+        let e = crate::render(
+            scene,
+            &RenderRequest {
+                overrides: Overrides {
+                    method: Some(scene::Method::GlobalDirect),
+                    photons: Some(a.photons),
+                    spp: Some(1),
+                    k: Some(a.k),
+                    kernel: Some(v.kernel),
+                    topo: v.topo,
+                    boundary: v.boundary,
+                    ..Overrides::default()
+                },
+                cache: &a.cache,
+                photons: Photons::CacheOnly,
                 threads: a.threads,
                 out: Some(out.clone()),
-                k: Some(a.k),
-                kernel: Some(v.kernel),
-                topo: v.topo,
-                drop_kth: false,
-                reference: Some(ref_dir.join("image.exr")),
                 exposure: 0.0,
+                reference: Some(&reference_exr),
                 label: Some(v.name.to_string()),
-                boundary: v.boundary,
-                gather_cache: 0,
             },
         )?;
         let img = film::read_exr(out.join("image.exr")).map_err(|e| e.to_string())?;

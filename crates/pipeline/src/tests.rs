@@ -1,6 +1,8 @@
-//! Unit tests of the binary's own machinery: the photon pipeline.
+//! Unit tests of the pipeline's machinery: the channel pipeline, the photon cache, the
+//! irradiance cache, the edge mask.
 
-use crate::pipeline::{self, CacheKey, PipelineOptions};
+use crate::flow::{self, ChannelSink, PipelineOptions, Sink, StoreSink};
+use crate::photon_cache::{self as pipeline, CacheKey};
 use crate::progress::Progress;
 use emit::{EmitParams, Plan};
 use std::path::{Path, PathBuf};
@@ -27,7 +29,7 @@ fn run(
     chunk: u64,
     window: usize,
     consumer: Option<crossbeam_channel::Sender<std::sync::Arc<emit::Traced>>>,
-) -> (Vec<Vec<u8>>, pipeline::TraceStats) {
+) -> (Vec<Vec<u8>>, flow::TraceStats) {
     let plan = Plan::for_scene(scene, params).unwrap();
     let key = CacheKey::new(scene, params);
     let files: Vec<(MapKind, PathBuf)> = pipeline::planned_kinds(&plan)
@@ -38,10 +40,17 @@ fn run(
         threads,
         chunk,
         window,
-        consumer,
     };
     let progress = Progress::new("test", params.photons, "photons");
-    let stats = pipeline::run(scene, params, &plan, &key, &files, &opts, &progress).unwrap();
+    let mut store = StoreSink::create(&files, &|k| key.header(scene, k)).unwrap();
+    let mut channel = consumer.map(ChannelSink);
+    let mut sinks: Vec<&mut dyn Sink> = vec![&mut store];
+    if let Some(c) = channel.as_mut() {
+        sinks.push(c);
+    }
+    let stats = flow::run(scene, params, &plan, &mut sinks, &opts, &progress).unwrap();
+    drop(sinks);
+    store.finish(params.photons).unwrap();
     let bytes = files
         .iter()
         .map(|(_, f)| std::fs::read(f).unwrap())
@@ -66,7 +75,7 @@ fn photon_files_are_bit_identical_for_any_thread_count_and_chunking() {
     let whole = emit::trace_range(&scene, &params, &plan, 0..params.photons);
     let key = CacheKey::new(&scene, &params);
     let g = MappedStore::open(&key.file(&d.join("a"), MapKind::Global)).unwrap();
-    assert_eq!(g.to_vec(), whole.global);
+    assert_eq!(g.to_vec(), whole[MapKind::Global]);
     assert_eq!(g.header().emitted, params.photons);
     let _ = std::fs::remove_dir_all(&d);
 }
@@ -89,7 +98,10 @@ fn backpressure_bounds_the_chunks_in_flight_and_the_consumer_sees_everything_in_
     );
     let got: Vec<std::sync::Arc<emit::Traced>> = rx.iter().collect();
     assert_eq!(got.len(), 150);
-    let caustic: Vec<store::Photon> = got.iter().flat_map(|t| t.caustic.iter().copied()).collect();
+    let caustic: Vec<store::Photon> = got
+        .iter()
+        .flat_map(|t| t[MapKind::Caustic].iter().copied())
+        .collect();
     let key = CacheKey::new(&scene, &params);
     let file = MappedStore::open(&key.file(&d, MapKind::Caustic)).unwrap();
     assert_eq!(
@@ -149,25 +161,30 @@ fn the_cache_reuses_only_identical_runs() {
 
 #[test]
 fn kernel_mass_on_surface_is_one_inside_and_drops_at_edges_and_corners() {
-    use crate::estimate::kernel_mass_on_surface;
-    use density::Kernel;
+    use crate::boundary::kernel_mass_on_surface;
+    use density::{EstimateParams, Kernel};
     use glam::Vec3;
     let s = cornell();
+    let with = |kernel| EstimateParams {
+        kernel,
+        topo: Some(0.1),
+        ..EstimateParams::default()
+    };
     // Floor centre, away from the spheres' footprints: the whole disc is floor.
     let centre = Vec3::new(-7.0, 0.0, -2.0);
-    let m = kernel_mass_on_surface(&s, centre, Vec3::Y, 0.5, Kernel::Uniform);
+    let m = kernel_mass_on_surface(&s, centre, Vec3::Y, 0.5, &with(Kernel::Uniform));
     assert_eq!(m, 1.0);
     // At the back wall (z = -13.98), the floor disc is cut in half.
     let edge = Vec3::new(-7.0, 0.0, -13.98);
-    let m = kernel_mass_on_surface(&s, edge, Vec3::Y, 0.5, Kernel::Uniform);
+    let m = kernel_mass_on_surface(&s, edge, Vec3::Y, 0.5, &with(Kernel::Uniform));
     assert!((m - 0.5).abs() < 0.07, "{m}");
     // In the floor's corner with the right wall (x = 0): a quarter.
     let corner = Vec3::new(0.0, 0.0, -13.98);
-    let m = kernel_mass_on_surface(&s, corner, Vec3::Y, 0.5, Kernel::Uniform);
+    let m = kernel_mass_on_surface(&s, corner, Vec3::Y, 0.5, &with(Kernel::Uniform));
     assert!((m - 0.25).abs() < 0.07, "{m}");
     // Past the open front (z = 0) the floor ends too.
     let front = Vec3::new(-7.0, 0.0, 0.0);
-    let m = kernel_mass_on_surface(&s, front, Vec3::Y, 0.5, Kernel::Silverman);
+    let m = kernel_mass_on_surface(&s, front, Vec3::Y, 0.5, &with(Kernel::Silverman));
     assert!((m - 0.5).abs() < 0.07, "{m}");
 }
 
@@ -211,7 +228,7 @@ fn the_edge_mask_marks_the_inner_edges_only() {
 
 #[test]
 fn the_gather_cache_answers_like_the_map_it_summarises() {
-    use crate::cache::IrradianceCache;
+    use crate::gather_cache::IrradianceCache;
     use density::{EstimateParams, IndexKind, PhotonMap};
     use glam::Vec3;
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/corner/corner.toml");
@@ -222,7 +239,7 @@ fn the_gather_cache_answers_like_the_map_it_summarises() {
     };
     let plan = Plan::for_scene(&scene, &params).unwrap();
     let traced = emit::trace_range(&scene, &params, &plan, 0..params.photons);
-    let map = PhotonMap::build(traced.global, 1, IndexKind::KdTree);
+    let map = PhotonMap::build(traced.sets.0[0].clone(), IndexKind::KdTree);
     let est = EstimateParams {
         k: 100,
         ..EstimateParams::default()
@@ -286,7 +303,7 @@ fn boundary_correction_removes_the_darkening_at_an_edge_and_a_corner() {
     // A 4 x 4 floor with photons of uniform density (irradiance E0 = 1) and nothing beyond
     // it: plain estimates near the edge see half a disc of photons (a quarter in the corner),
     // corrected ones divide by the kernel mass on the floor and recover E0.
-    use crate::estimate::kernel_mass_on_surface;
+    use crate::boundary::kernel_mass_on_surface;
     use density::{EstimateParams, IndexKind, Kernel, KnnHint, PhotonMap};
     use glam::Vec3;
     let dir = scratch("edge");
@@ -314,7 +331,7 @@ fn boundary_correction_removes_the_darkening_at_an_edge_and_a_corner() {
             store::Photon::new(p, Vec3::splat(power), -Vec3::Y, 0)
         })
         .collect();
-    let map = PhotonMap::build(photons, 1, IndexKind::KdTree);
+    let map = PhotonMap::build(photons, IndexKind::KdTree);
     // Edge points: 20 along each of the 4 edges, a disc radius (~0.08) or more apart, so the
     // estimates are nearly independent; corner points: the 4 corners. One k = 1000 estimate
     // has relative noise ~1.5/sqrt(1000) = 5%: the means then carry ~0.8% (edges) and ~2.4%
@@ -352,7 +369,7 @@ fn boundary_correction_removes_the_darkening_at_an_edge_and_a_corner() {
                 let e = map
                     .irradiance_hinted(x, Vec3::Y, &est, &mut hint, &mut scratch)
                     .x;
-                let m = kernel_mass_on_surface(&scene, x, Vec3::Y, hint.r, kernel);
+                let m = kernel_mass_on_surface(&scene, x, Vec3::Y, hint.r, &est);
                 plain += e as f64;
                 corrected += (e / m) as f64;
             }

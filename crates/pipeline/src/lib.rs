@@ -1,0 +1,136 @@
+//! `pipeline`: the stages wired together as a library, so that everything a command does can
+//! be called (and tested) in one process. The binary `photonflow` parses flags, picks paths
+//! and calls [`render`] or [`trace`]; the end-to-end tests call the same functions.
+//!
+//! - [`settings`]: the scene file's `[photons]` and `[estimate]` tables, typed, with the
+//!   command line's overrides; the resolved scene file every output directory holds.
+//! - [`flow`]: the channel pipeline (emission workers → bounded channel → chunks in index
+//!   order → [`flow::Sink`]s: the photon file writer, or any stage behind a channel).
+//! - [`photon_cache`]: cached photon sets keyed by what they depend on, traced on demand,
+//!   loaded as photon maps.
+//! - [`maps`], [`gather_cache`], [`boundary`]: the photon maps behind the eye pass, the
+//!   irradiance cache of final gathering, the boundary-bias correction.
+//! - [`methods`]: one file per method, one `match` on `scene::Method`.
+//! - [`output`]: a run's directory (EXR, PNG, layers, JSON, resolved scene).
+//! - [`worksheet`]: worksheet 7's report.
+//!
+//! File IO happens only at paths the caller passes in.
+
+pub mod boundary;
+pub mod flow;
+pub mod gather_cache;
+pub mod maps;
+pub mod methods;
+pub mod output;
+pub mod photon_cache;
+pub mod progress;
+pub mod settings;
+pub mod worksheet;
+
+#[cfg(test)]
+mod tests;
+
+pub use methods::{Photons, Rendered, Run};
+pub use settings::{EstimateSettings, Overrides, Settings};
+
+use progress::Progress;
+use scene::Scene;
+use std::path::{Path, PathBuf};
+
+/// One `render` or `estimate` command.
+pub struct RenderRequest<'a> {
+    pub overrides: Overrides,
+    pub cache: &'a Path,
+    pub photons: Photons,
+    pub threads: Option<usize>,
+    /// Output directory; `None`: [`output::default_out`] of the label.
+    pub out: Option<PathBuf>,
+    pub exposure: f32,
+    pub reference: Option<&'a Path>,
+    /// The output directory's method part (default: the method's name).
+    pub label: Option<String>,
+}
+
+/// What a command produced.
+pub struct RenderSummary {
+    pub out: PathBuf,
+    pub settings: Settings,
+    pub image: film::Image,
+    pub metrics: Option<film::Metrics>,
+    pub seconds: f64,
+}
+
+/// Renders `scene` with the request's settings and writes the run's directory.
+pub fn render(scene: &Scene, req: &RenderRequest) -> Result<RenderSummary, String> {
+    let t0 = std::time::Instant::now();
+    let settings = Settings::new(scene, &req.overrides)?;
+    let run = Run {
+        scene,
+        settings: &settings,
+        cache: req.cache,
+        photons: req.photons,
+        threads: req.threads,
+    };
+    let label = req.label.clone().unwrap_or_else(|| settings.method.name());
+    let out = req
+        .out
+        .clone()
+        .unwrap_or_else(|| output::default_out(&scene.path, &label));
+    // Everything that can refuse the run is checked before the render starts.
+    let reference = match req.reference {
+        Some(p) => {
+            let img = film::read_exr(p).map_err(|e| e.to_string())?;
+            let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+            if (img.width, img.height) != (w, h) {
+                return Err(format!(
+                    "{}: reference is {}x{}, the scene renders {w}x{h}",
+                    p.display(),
+                    img.width,
+                    img.height
+                ));
+            }
+            Some((p, img))
+        }
+        None => None,
+    };
+    if !req.exposure.is_finite() {
+        return Err(format!("--exposure {} must be finite", req.exposure));
+    }
+    let progress = Progress::new(&settings.method.name(), methods::work(&run), "samples");
+    let rendered = methods::render(&run, &|n| progress.inc(n))?;
+    progress.finish();
+    let seconds = t0.elapsed().as_secs_f64();
+    let (image, metrics) = output::write(
+        scene,
+        &settings,
+        &rendered,
+        &output::OutputOptions {
+            out: &out,
+            exposure: req.exposure,
+            reference: reference.as_ref().map(|(p, i)| (*p, i)),
+            label: &label,
+            threads: run.threads(),
+            seconds,
+        },
+    )?;
+    Ok(RenderSummary {
+        out,
+        settings,
+        image,
+        metrics,
+        seconds,
+    })
+}
+
+/// Traces (or reuses) the photon sets `scene` needs into `cache`.
+pub fn trace(
+    scene: &Scene,
+    overrides: &Overrides,
+    cache: &Path,
+    threads: Option<usize>,
+    force: bool,
+) -> Result<photon_cache::TraceOutput, String> {
+    let settings = Settings::new(scene, overrides)?;
+    let threads = threads.unwrap_or_else(rayon::current_num_threads);
+    photon_cache::trace(scene, &settings.emit, cache, threads, force)
+}

@@ -1,0 +1,67 @@
+//! `final-gather`: the course framework's standard. Direct light by next-event estimation,
+//! caustics from the caustic map, indirect light by `[estimate.final_gather] rays` gather rays
+//! per sample reading the global map, through an irradiance cache precomputed at every
+//! `cache`-th global photon (Christensen 1999; 0 reads the map at every gather hit).
+
+use super::{CountKind, Rendered, Run};
+use crate::gather_cache::IrradianceCache;
+use store::MapKind;
+
+pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
+    let mut inputs = super::photon_inputs(run, true)?;
+    let fg = run.settings.estimate.final_gather;
+    let spp = run.settings.estimate.spp;
+    let t_cache = std::time::Instant::now();
+    if fg.cache > 0 {
+        // The cache stores exactly what a direct lookup would answer at its points, boundary
+        // correction included.
+        let maps = &inputs.maps;
+        let c = IrradianceCache::build(
+            run.scene,
+            maps.maps[MapKind::Global].as_ref(),
+            fg.cache,
+            &|x, n, h, s| maps.estimate(MapKind::Global, x, n, h, s),
+        );
+        println!(
+            "irradiance cache: {} points (every {}th global photon) in {:.2} s",
+            c.len(),
+            fg.cache,
+            t_cache.elapsed().as_secs_f64()
+        );
+        inputs.maps.gather_cache = Some(c);
+    }
+    let t_cache = t_cache.elapsed().as_secs_f64();
+    let t0 = std::time::Instant::now();
+    let film = eye::render_final_gather(
+        run.scene,
+        &run.render_options(spp),
+        fg.rays,
+        &inputs.maps,
+        progress,
+    );
+    let seconds = t0.elapsed().as_secs_f64();
+    let mut info = super::photon_info(run, &inputs);
+    info.insert("gather_rays".into(), fg.rays.into());
+    info.insert(
+        "gather_cache_stride".into(),
+        (fg.cache > 0).then_some(fg.cache).into(),
+    );
+    info.insert("time_gather_cache_s".into(), t_cache.into());
+    info.insert("time_render_s".into(), seconds.into());
+    Ok(Rendered {
+        layers: super::layers(
+            &film,
+            spp,
+            &[
+                ("emitted", &["emitted"]),
+                ("direct", &["direct"]),
+                ("caustic", &["caustic"]),
+                ("indirect", &["indirect", "caustic_indirect"]),
+            ],
+        ),
+        count: run.settings.emit.photons,
+        count_kind: CountKind::PhotonPaths,
+        plan: Some(inputs.plan),
+        info,
+    })
+}

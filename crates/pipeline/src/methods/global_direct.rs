@@ -1,0 +1,33 @@
+//! `global-direct`: the global photon map shown directly at the first diffuse surface seen
+//! from the eye (worksheet 7's visualisation), with the `[estimate]` kernel, topological test
+//! and boundary correction.
+
+use super::{CountKind, Rendered, Run};
+
+pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
+    let inputs = super::photon_inputs(run, false)?;
+    let spp = run.settings.estimate.spp;
+    let t0 = std::time::Instant::now();
+    let film =
+        eye::render_global_direct(run.scene, &run.render_options(spp), &inputs.maps, progress);
+    let seconds = t0.elapsed().as_secs_f64();
+    let mut info = super::photon_info(run, &inputs);
+    info.insert("time_render_s".into(), seconds.into());
+    Ok(Rendered {
+        layers: super::layers(
+            &film,
+            spp,
+            &[
+                ("emitted", &["emitted"]),
+                (
+                    "global",
+                    &["direct", "indirect", "caustic", "caustic_indirect"],
+                ),
+            ],
+        ),
+        count: run.settings.emit.photons,
+        count_kind: CountKind::PhotonPaths,
+        plan: Some(inputs.plan),
+        info,
+    })
+}

@@ -1,0 +1,241 @@
+//! The methods, one file each, behind one dispatch: [`render`] matches `scene::Method` and
+//! nothing else does. A method gets a [`Run`] (the scene, its settings, where photon sets are
+//! cached and whether it may trace them) and returns [`Rendered`] layers, each tagged with
+//! the light-path classes it estimates so that layers of separate runs can be composited
+//! without counting a path twice.
+
+mod final_gather;
+mod global_direct;
+mod path;
+
+use crate::maps::Maps;
+use crate::photon_cache::{self, CacheKey};
+use crate::settings::Settings;
+use emit::Plan;
+use film::{Film, Image, Normalize};
+use scene::{Method, Scene};
+use std::path::Path;
+use store::MapKind;
+
+/// The light-path classes of the path tracer's layers (eye::Part), which every layer's
+/// `classes` are drawn from.
+pub const CLASSES: [&str; 5] = [
+    "emitted",
+    "direct",
+    "indirect",
+    "caustic",
+    "caustic_indirect",
+];
+
+/// Where a photon method gets its photon sets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Photons {
+    /// Reuse the cached sets or trace them (`render`).
+    TraceOrReuse,
+    /// Cached sets only, never trace (`estimate`: swap the estimator alone).
+    CacheOnly,
+}
+
+/// One run's inputs.
+pub struct Run<'a> {
+    pub scene: &'a Scene,
+    pub settings: &'a Settings,
+    /// Photon cache directory.
+    pub cache: &'a Path,
+    pub photons: Photons,
+    /// Worker threads (`None`: all cores). Never changes an image.
+    pub threads: Option<usize>,
+}
+
+impl Run<'_> {
+    pub fn threads(&self) -> usize {
+        self.threads.unwrap_or_else(rayon::current_num_threads)
+    }
+
+    pub(crate) fn render_options(&self, spp: u32) -> eye::RenderOptions {
+        eye::RenderOptions {
+            spp,
+            caustics: true,
+            threads: self.threads,
+            tile: self.settings.render.tile,
+        }
+    }
+}
+
+/// One layer of an image: its name, the light-path classes ([`CLASSES`]) it estimates, and
+/// its pixels (already divided by the sample count).
+pub struct Layer {
+    pub name: String,
+    pub classes: Vec<&'static str>,
+    pub image: Image,
+}
+
+/// What a method made.
+pub struct Rendered {
+    pub layers: Vec<Layer>,
+    /// The run's weight when runs are composited, and what it counts.
+    pub count: u64,
+    pub count_kind: CountKind,
+    /// The effects plan, for photon methods.
+    pub plan: Option<Plan>,
+    /// Method-specific facts for `image.json` (settings used, photon counts, timings).
+    pub info: serde_json::Map<String, serde_json::Value>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CountKind {
+    /// Samples per pixel.
+    Spp,
+    /// Photon paths emitted.
+    PhotonPaths,
+}
+
+impl CountKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            CountKind::Spp => "spp",
+            CountKind::PhotonPaths => "photon_paths",
+        }
+    }
+}
+
+/// Runs the method the settings name.
+pub fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
+    if run.threads == Some(0) {
+        return Err("--threads must be at least 1".into());
+    }
+    match run.settings.method {
+        Method::Path => path::render(run, progress),
+        Method::GlobalDirect => global_direct::render(run, progress),
+        Method::FinalGather => final_gather::render(run, progress),
+    }
+}
+
+/// Total work units (samples) of a run, for a progress bar.
+pub fn work(run: &Run) -> u64 {
+    let (w, h) = (
+        run.scene.camera.width as u64,
+        run.scene.camera.height as u64,
+    );
+    let spp = match run.settings.method {
+        Method::Path => run.settings.render.spp,
+        _ => run.settings.estimate.spp,
+    };
+    w * h * spp as u64
+}
+
+/// The film's layers divided by `spp`, tagged with their classes.
+pub(crate) fn layers(film: &Film, spp: u32, classes: &[(&str, &[&'static str])]) -> Vec<Layer> {
+    classes
+        .iter()
+        .filter_map(|(name, cls)| {
+            let img = film.layer(name)?.resolve(Normalize::Constant(spp as f64));
+            Some(Layer {
+                name: name.to_string(),
+                classes: cls.to_vec(),
+                image: img,
+            })
+        })
+        .collect()
+}
+
+/// Photon maps for a photon method: the plan's sets `needed` (traced or reused, or read from
+/// the cache only), after refusing settings that would silently darken a layer.
+pub(crate) struct PhotonInputs<'a> {
+    pub plan: Plan,
+    pub maps: Maps<'a>,
+    pub seconds_trace: f64,
+    pub reused: bool,
+    pub seconds_load: f64,
+}
+
+pub(crate) fn photon_inputs<'a>(
+    run: &Run<'a>,
+    needs_caustic: bool,
+) -> Result<PhotonInputs<'a>, String> {
+    let scene = run.scene;
+    let s = run.settings;
+    let params = &s.emit;
+    let plan =
+        Plan::for_scene(scene, params).map_err(|e| format!("{}: {e}", scene.path.display()))?;
+    // These methods read the global map as the full light arriving at a surface, direct hits
+    // included; final gathering also needs the caustic map wherever the scene can make
+    // caustics. A missing set would silently darken a layer, so it is an error.
+    let incomplete = if !plan.global {
+        Some(
+            "the effects plan traces no global photons (no diffuse surface, or [photons] global = false)",
+        )
+    } else if !params.store_direct {
+        Some(
+            "[photons] store_direct = false leaves direct light out of the global map these methods read",
+        )
+    } else if needs_caustic && !params.caustic && scene.materials.iter().any(|m| m.is_specular()) {
+        Some("[photons] caustic = false leaves the caustic layer of final gathering empty")
+    } else {
+        None
+    };
+    if let Some(why) = incomplete {
+        return Err(format!("{}: {why}", scene.path.display()));
+    }
+    let (seconds_trace, reused) = match run.photons {
+        Photons::TraceOrReuse => {
+            let t = photon_cache::trace(scene, params, run.cache, run.threads(), false)?;
+            (t.seconds, t.reused)
+        }
+        Photons::CacheOnly => (0.0, true),
+    };
+    let t0 = std::time::Instant::now();
+    let key = CacheKey::new(scene, params);
+    let kinds: Vec<MapKind> = if needs_caustic {
+        photon_cache::planned_kinds(&plan)
+    } else {
+        vec![MapKind::Global]
+    };
+    let maps = photon_cache::load_maps(run.cache, &key, &kinds)?;
+    let mut params_per_kind = store::PerKind::default();
+    params_per_kind[MapKind::Global] = s.estimate.global;
+    params_per_kind[MapKind::Caustic] = s.estimate.caustic;
+    Ok(PhotonInputs {
+        plan,
+        maps: Maps {
+            maps,
+            params: params_per_kind,
+            boundary: s.estimate.boundary.then_some(scene),
+            gather_cache: None,
+        },
+        seconds_trace,
+        reused,
+        seconds_load: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// The JSON facts every photon method records.
+pub(crate) fn photon_info(
+    run: &Run,
+    inputs: &PhotonInputs,
+) -> serde_json::Map<String, serde_json::Value> {
+    let s = run.settings;
+    let count = |k: MapKind| inputs.maps.maps[k].as_ref().map_or(0, |m| m.len());
+    let mut j = serde_json::Map::new();
+    let mut put = |k: &str, v: serde_json::Value| {
+        j.insert(k.to_string(), v);
+    };
+    put("spp", s.estimate.spp.into());
+    put("photons_emitted", s.emit.photons.into());
+    put("global_photons", count(MapKind::Global).into());
+    put("caustic_photons", count(MapKind::Caustic).into());
+    put("global_estimate", serde_json::json!(s.estimate.global));
+    put("caustic_estimate", serde_json::json!(s.estimate.caustic));
+    put(
+        "kernel",
+        crate::settings::kernel_name(s.estimate.global.kernel).into(),
+    );
+    put("boundary_correction", s.estimate.boundary.into());
+    put(
+        "trace",
+        if inputs.reused { "reused" } else { "traced" }.into(),
+    );
+    put("time_trace_s", inputs.seconds_trace.into());
+    put("time_load_and_index_s", inputs.seconds_load.into());
+    j
+}

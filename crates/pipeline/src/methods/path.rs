@@ -1,0 +1,51 @@
+//! `path`: the independent path-traced reference (`eye::render`), `render.spp` samples per
+//! pixel, caustic paths left out when `render.caustics` is off.
+
+use super::{CountKind, Layer, Rendered, Run};
+use eye::Part;
+
+pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
+    let r = &run.settings.render;
+    let opts = eye::RenderOptions {
+        caustics: r.caustics,
+        ..run.render_options(r.spp)
+    };
+    let t0 = std::time::Instant::now();
+    let film = eye::render(run.scene, &opts, progress);
+    let seconds = t0.elapsed().as_secs_f64();
+    // Each path-traced layer is one class; with caustics off the caustic layers estimate
+    // nothing and are left out, so a caustic image made elsewhere can take their place.
+    let parts: Vec<Part> = Part::ALL
+        .into_iter()
+        .filter(|p| r.caustics || !p.is_caustic())
+        .collect();
+    let classes: Vec<(&str, &[&'static str])> = parts
+        .iter()
+        .map(|p| (p.name(), std::slice::from_ref(&super::CLASSES[*p as usize])))
+        .collect();
+    let layers: Vec<Layer> = super::layers(&film, r.spp, &classes);
+    let (w, h) = (
+        run.scene.camera.width as u64,
+        run.scene.camera.height as u64,
+    );
+    let samples = w * h * r.spp as u64;
+    let mut info = serde_json::Map::new();
+    for (k, v) in [
+        ("spp", serde_json::json!(r.spp)),
+        ("caustics", r.caustics.into()),
+        ("max_depth", r.max_depth.into()),
+        ("rr_depth", r.rr_depth.into()),
+        ("samples", samples.into()),
+        ("time_render_s", seconds.into()),
+        ("samples_per_s", (samples as f64 / seconds).into()),
+    ] {
+        info.insert(k.to_string(), v);
+    }
+    Ok(Rendered {
+        layers,
+        count: r.spp as u64,
+        count_kind: CountKind::Spp,
+        plan: None,
+        info,
+    })
+}

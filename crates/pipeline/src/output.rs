@@ -1,0 +1,130 @@
+//! A run's output directory: `image.exr` (linear), `image.png` (tone-mapped), `layers/`,
+//! `image.json` (settings, counts, layer classes, timings, errors against a reference) and
+//! `scene.toml`, the resolved scene file that reproduces the run bit for bit. Everything that
+//! can fail (the reference, the settings' serialisation) is checked before the first byte is
+//! written.
+
+use crate::methods::Rendered;
+use crate::settings::Settings;
+use film::{Image, Mask, ToneMap};
+use scene::Scene;
+use std::path::{Path, PathBuf};
+
+/// Default output directory: `out/<scene dir>-<scene file stem>-<label>`.
+pub fn default_out(scene: &Path, label: &str) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into());
+    let parent = scene
+        .parent()
+        .and_then(|p| p.file_name())
+        .map(|s| s.to_string_lossy().into_owned());
+    let name = match parent {
+        Some(p) if !p.is_empty() => format!("{p}-{stem}"),
+        _ => stem,
+    };
+    PathBuf::from("out").join(format!("{name}-{label}"))
+}
+
+/// How to write a run.
+pub struct OutputOptions<'a> {
+    pub out: &'a Path,
+    pub exposure: f32,
+    /// Compare with this linear image (read from the path) and record the errors.
+    pub reference: Option<(&'a Path, &'a Image)>,
+    /// Recorded as `label` (the output directory's method part).
+    pub label: &'a str,
+    pub threads: usize,
+    pub seconds: f64,
+}
+
+/// Writes `r` into `o.out`; returns the image (the sum of the layers) and the metrics
+/// against the reference, if any.
+pub fn write(
+    scene: &Scene,
+    settings: &Settings,
+    r: &Rendered,
+    o: &OutputOptions,
+) -> Result<(Image, Option<film::Metrics>), String> {
+    if !o.exposure.is_finite() {
+        return Err(format!("--exposure {} must be finite", o.exposure));
+    }
+    let parts: Vec<(&Image, f32)> = r.layers.iter().map(|l| (&l.image, 1.0)).collect();
+    let image = film::composite(&parts).map_err(|e| e.to_string())?;
+    let metrics = match o.reference {
+        Some((p, reference)) => Some(
+            film::metrics(&image, reference, None).map_err(|e| format!("{}: {e}", p.display()))?,
+        ),
+        None => None,
+    };
+    let resolved = settings.resolved_scene(scene)?;
+    let scene_text = toml::to_string(&resolved).map_err(|e| {
+        format!(
+            "{}: the resolved scene does not serialise: {e}",
+            scene.path.display()
+        )
+    })?;
+    let tone = ToneMap {
+        exposure: o.exposure,
+        ..ToneMap::default()
+    };
+    let mut json = serde_json::json!({
+        "scene": scene.path.display().to_string(),
+        "scene_hash": format!("{:016x}", scene.content_hash),
+        "image_hash": format!("{:016x}", scene.image_hash),
+        "photon_hash": format!("{:016x}", scene.photon_hash),
+        "view_hash": format!("{:016x}", scene.view_hash),
+        "method": settings.method.name(),
+        "label": o.label,
+        "seed": scene.seed(),
+        "width": image.width,
+        "height": image.height,
+        "count": r.count,
+        "count_kind": r.count_kind.name(),
+        "layers": r.layers.iter().map(|l| (l.name.clone(), serde_json::json!(l.classes)))
+            .collect::<serde_json::Map<_, _>>(),
+        "threads": o.threads,
+        "time_total_s": o.seconds,
+        "tone_map": { "gamma": tone.gamma, "exposure": tone.exposure },
+        "reference": o.reference.map(|(p, _)| p.display().to_string()),
+        "rmse": metrics.as_ref().map(|m| m.rmse),
+        "relmse": metrics.as_ref().map(|m| m.relmse),
+        "mae": metrics.as_ref().map(|m| m.mae),
+        "mean": metrics.as_ref().map(|m| m.mean_a),
+        "mean_reference": metrics.as_ref().map(|m| m.mean_b),
+    });
+    if let Some(obj) = json.as_object_mut() {
+        for (k, v) in &r.info {
+            obj.insert(k.clone(), v.clone());
+        }
+    }
+    let json_text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
+
+    let out = o.out;
+    std::fs::create_dir_all(out.join("layers"))
+        .map_err(|e| format!("{}: cannot create output directory: {e}", out.display()))?;
+    film::write_exr(out.join("image.exr"), &image).map_err(|e| e.to_string())?;
+    film::write_png(out.join("image.png"), &image, &tone).map_err(|e| e.to_string())?;
+    for l in &r.layers {
+        film::write_exr(out.join("layers").join(format!("{}.exr", l.name)), &l.image)
+            .map_err(|e| e.to_string())?;
+    }
+    let w = |name: &str, bytes: &[u8]| {
+        film::write_atomic(&out.join(name), bytes).map_err(|e| e.to_string())
+    };
+    w("image.json", json_text.as_bytes())?;
+    w("scene.toml", scene_text.as_bytes())?;
+    if let Some(plan) = &r.plan {
+        w("plan.txt", plan.to_string().as_bytes())?;
+    }
+    Ok((image, metrics))
+}
+
+/// Error metrics of image `a` against reference `b` (linear EXR files), inside `mask`.
+pub fn compare(a: &Path, b: &Path, mask: Option<[usize; 4]>) -> Result<film::Metrics, String> {
+    let ia = film::read_exr(a).map_err(|e| e.to_string())?;
+    let ib = film::read_exr(b).map_err(|e| e.to_string())?;
+    let mask = mask.map(|[x0, y0, x1, y1]| Mask::rect(ia.width, ia.height, x0, y0, x1, y1));
+    film::metrics(&ia, &ib, mask.as_ref()).map_err(|e| e.to_string())
+}

@@ -1,0 +1,272 @@
+//! The parameters of a run, parsed once per command from the scene file: `[render]` (typed
+//! by `scene`), `[photons]` (`emit::EmitParams`) and `[estimate]` ([`EstimateSettings`]).
+//! `scene` keeps the last two opaque so it stays below the stages that own them; they are
+//! parsed here and nowhere else. Flags only override ([`Overrides`]); the resolved settings
+//! are written back into a scene file ([`Settings::resolved_scene`]) that reproduces the run.
+
+use density::{EstimateParams, Kernel};
+use emit::EmitParams;
+use scene::{Method, Scene, SceneFile};
+use serde::{Deserialize, Serialize};
+
+/// The `[estimate]` table: every knob of the photon-map methods. Each method's own knobs sit
+/// in a sub-table named after it (`[estimate.final_gather]`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct EstimateSettings {
+    /// Samples per pixel of the photon-map eye passes (each already averages many photons).
+    pub spp: u32,
+    /// Correct global-map estimates for boundary bias: divide by the share of the kernel's
+    /// mass that lies on the surface (needs `global.topo`).
+    pub boundary: bool,
+    /// The global map's estimate (course framework: k = 1000).
+    pub global: EstimateParams,
+    /// The caustic map's estimate (course framework: k = 250).
+    pub caustic: EstimateParams,
+    pub final_gather: FinalGatherSettings,
+}
+
+/// `[estimate.final_gather]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FinalGatherSettings {
+    /// Gather rays per pixel sample.
+    pub rays: u32,
+    /// Final gathering reads irradiance precomputed at every `cache`-th global photon
+    /// (Christensen 1999); 0 estimates from the map at every gather hit.
+    pub cache: usize,
+}
+
+impl Default for FinalGatherSettings {
+    fn default() -> Self {
+        FinalGatherSettings { rays: 16, cache: 4 }
+    }
+}
+
+const GLOBAL_K: usize = 1000;
+const CAUSTIC_K: usize = 250;
+
+impl Default for EstimateSettings {
+    fn default() -> Self {
+        EstimateSettings {
+            spp: 1,
+            boundary: false,
+            global: EstimateParams {
+                k: GLOBAL_K,
+                ..EstimateParams::default()
+            },
+            caustic: EstimateParams {
+                k: CAUSTIC_K,
+                ..EstimateParams::default()
+            },
+            final_gather: FinalGatherSettings::default(),
+        }
+    }
+}
+
+/// Command-line overrides of scene-file settings; `None`/`false` leaves the file's value.
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    pub method: Option<Method>,
+    /// Samples per pixel of whichever method runs.
+    pub spp: Option<u32>,
+    pub photons: Option<u64>,
+    /// Global-map estimate.
+    pub k: Option<usize>,
+    pub kernel: Option<Kernel>,
+    pub topo: Option<f32>,
+    pub drop_kth: bool,
+    pub boundary: bool,
+    pub gather_rays: Option<u32>,
+    pub gather_cache: Option<usize>,
+    /// Leave caustic paths out of the path tracer.
+    pub no_caustics: bool,
+}
+
+/// Everything a run needs besides the scene's geometry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    pub method: Method,
+    /// `[render]`, with `spp` and `caustics` overridden for the path tracer.
+    pub render: scene::RenderSettings,
+    pub emit: EmitParams,
+    pub estimate: EstimateSettings,
+}
+
+impl Settings {
+    /// Parses the scene's tables and applies `o`. Errors name the scene file.
+    pub fn new(scene: &Scene, o: &Overrides) -> Result<Settings, String> {
+        let file = &scene.file;
+        let err = |m: String| format!("{}: {m}", scene.path.display());
+        let mut emit: EmitParams = toml::Value::Table(file.photons.clone())
+            .try_into()
+            .map_err(|e| err(format!("[photons]: {e}")))?;
+        let mut estimate = parse_estimate(&file.estimate).map_err(err)?;
+        let mut render = file.render.clone();
+        let method = o.method.unwrap_or(render.method);
+        render.method = method;
+        if let Some(n) = o.photons {
+            emit.photons = n;
+        }
+        if let Some(spp) = o.spp {
+            match method {
+                Method::Path => render.spp = spp,
+                _ => estimate.spp = spp,
+            }
+        }
+        render.caustics &= !o.no_caustics;
+        let g = &mut estimate.global;
+        if let Some(k) = o.k {
+            g.k = k;
+        }
+        if let Some(kern) = o.kernel {
+            g.kernel = kern;
+        }
+        if let Some(eps) = o.topo {
+            g.topo = Some(eps);
+        }
+        g.drop_kth |= o.drop_kth;
+        estimate.boundary |= o.boundary;
+        if let Some(r) = o.gather_rays {
+            estimate.final_gather.rays = r;
+        }
+        if let Some(c) = o.gather_cache {
+            estimate.final_gather.cache = c;
+        }
+        let s = Settings {
+            method,
+            render,
+            emit,
+            estimate,
+        };
+        s.validate().map_err(err)?;
+        Ok(s)
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        let e = &self.estimate;
+        if self.emit.photons == 0 || self.emit.photons > 1 << 40 {
+            return Err(format!(
+                "photons = {} must be in 1..=2^40",
+                self.emit.photons
+            ));
+        }
+        if self.render.spp == 0 || self.render.spp > 1 << 24 {
+            return Err(format!(
+                "render.spp = {} must be in 1..=16777216",
+                self.render.spp
+            ));
+        }
+        if e.spp == 0 || e.spp > 1 << 20 {
+            return Err(format!("estimate.spp = {} must be in 1..=1048576", e.spp));
+        }
+        for (name, p) in [("global", &e.global), ("caustic", &e.caustic)] {
+            if p.k == 0 || p.k > 1 << 20 {
+                return Err(format!(
+                    "estimate.{name}.k = {} must be in 1..=1048576",
+                    p.k
+                ));
+            }
+            if let Some(eps) = p.topo
+                && !(eps > 0.0 && eps <= 1.0)
+            {
+                return Err(format!("estimate.{name}.topo = {eps} must be in (0, 1]"));
+            }
+            if p.r_max.is_nan() || p.r_max <= 0.0 {
+                return Err(format!(
+                    "estimate.{name}.r_max = {} must be positive",
+                    p.r_max
+                ));
+            }
+        }
+        if e.final_gather.rays > 1 << 16 {
+            return Err(format!(
+                "estimate.final_gather.rays = {} is absurd (at most 65536)",
+                e.final_gather.rays
+            ));
+        }
+        if e.boundary && e.global.topo.is_none() {
+            return Err(
+                "boundary correction needs the topological test (estimate.global.topo, or \
+                 --topo EPS): the correction divides by the share of the disc on this surface, \
+                 so photons from other surfaces must be excluded first or they are amplified too"
+                    .into(),
+            );
+        }
+        Ok(())
+    }
+
+    /// The scene file with these settings written in, mesh paths made absolute: rendering it
+    /// again reproduces the run bit for bit (the thread count never changes an image).
+    pub fn resolved_scene(&self, scene: &Scene) -> Result<SceneFile, String> {
+        let mut f = scene.file.clone();
+        f.render = self.render.clone();
+        let table = |v: Result<toml::Value, toml::ser::Error>| match v {
+            Ok(toml::Value::Table(t)) => Ok(t),
+            Ok(other) => Err(format!("settings serialise to {other}, not a table")),
+            Err(e) => Err(format!("settings do not serialise: {e}")),
+        };
+        f.photons = table(toml::Value::try_from(&self.emit))?;
+        f.estimate = table(toml::Value::try_from(&self.estimate))?;
+        let dir = scene.path.parent().unwrap_or(std::path::Path::new(""));
+        for m in &mut f.meshes {
+            let p = dir.join(&m.obj);
+            let abs = std::path::absolute(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+            m.obj = abs.to_string_lossy().into_owned();
+        }
+        Ok(f)
+    }
+}
+
+/// `[estimate]` with the framework's per-map defaults of k filled in where a sub-table leaves
+/// k out (a bare `[estimate.global]` table would otherwise take `EstimateParams`' k = 50).
+fn parse_estimate(t: &toml::Table) -> Result<EstimateSettings, String> {
+    let mut t = t.clone();
+    for (map, k) in [("global", GLOBAL_K), ("caustic", CAUSTIC_K)] {
+        if let Some(v) = t.get_mut(map) {
+            let toml::Value::Table(sub) = v else {
+                return Err(format!("[estimate.{map}] must be a table, not {v}"));
+            };
+            sub.entry("k").or_insert(toml::Value::Integer(k as i64));
+        }
+    }
+    toml::Value::Table(t)
+        .try_into()
+        .map_err(|e| format!("[estimate]: {e}"))
+}
+
+/// A kernel as the command line spells it (`--kernel`); the scene file uses
+/// `kernel = { kind = "silverman" }` (serde).
+pub fn parse_kernel(s: &str) -> Result<Kernel, String> {
+    Ok(match s {
+        "uniform" | "box" => Kernel::Uniform,
+        "silverman" | "simpson" => Kernel::Silverman,
+        "epanechnikov" => Kernel::Epanechnikov,
+        "triweight" => Kernel::Triweight,
+        "gaussian" => Kernel::Gaussian,
+        "gaussian-jensen" => Kernel::GaussianJensen,
+        "cone" => Kernel::Cone { k: 1.0 },
+        _ => match s.strip_prefix("cone:").map(str::parse::<f32>) {
+            Some(Ok(k)) if k >= 1.0 && k.is_finite() => Kernel::Cone { k },
+            _ => {
+                return Err(format!(
+                    "unknown kernel `{s}` (uniform, silverman, epanechnikov, triweight, gaussian, \
+                     gaussian-jensen, cone, cone:K with K >= 1)"
+                ));
+            }
+        },
+    })
+}
+
+/// The name [`parse_kernel`] reads back.
+pub fn kernel_name(k: Kernel) -> String {
+    match k {
+        Kernel::Uniform => "uniform".into(),
+        Kernel::Silverman => "silverman".into(),
+        Kernel::Epanechnikov => "epanechnikov".into(),
+        Kernel::Triweight => "triweight".into(),
+        Kernel::Gaussian => "gaussian".into(),
+        Kernel::GaussianJensen => "gaussian-jensen".into(),
+        Kernel::Cone { k } => format!("cone:{k}"),
+    }
+}

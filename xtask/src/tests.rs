@@ -1,0 +1,140 @@
+//! Unit tests of xtask's own logic: argument parsing and the benchmark record. The repository
+//! rules live in `tidy.rs`.
+
+use std::path::Path;
+
+use crate::benchmarks::{self, cpu_model, replace_section, section, utc};
+use crate::flags::{self, Bench, Cmd};
+
+fn strings(v: &[&str]) -> Vec<String> {
+    v.iter().map(|s| s.to_string()).collect()
+}
+
+fn bench(args: &[&str]) -> Bench {
+    match flags::parse(&strings(args)) {
+        Ok(Cmd::Bench(b)) => b,
+        _ => panic!("{args:?} is not a benchmark"),
+    }
+}
+
+#[test]
+fn bench_commands_keep_what_was_typed_and_add_the_default_scene() {
+    let b = bench(&["bench", "rays", "--compare"]);
+    assert_eq!(b.what, "rays");
+    assert_eq!(b.typed, ["rays", "--compare"]);
+    assert_eq!(b.args, ["bench-rays", flags::DEFAULT_SCENE, "--compare"]);
+    let b = bench(&["bench", "photons", "scenes/corner/corner.toml"]);
+    assert_eq!(b.args, ["bench-photons", "scenes/corner/corner.toml"]);
+    let b = bench(&["bench", "store", "--photons", "100"]);
+    assert_eq!(b.args, ["bench-store", "--photons", "100"]);
+    assert!(flags::parse(&strings(&["bench", "nope"])).is_err());
+}
+
+const DOC: &str = "\
+# Benchmarks
+
+Intro.
+
+## bench store
+
+(moved from the crate docs)
+
+| a | b |
+
+## bench knn
+
+Placeholder.
+";
+
+#[test]
+fn a_section_is_replaced_in_place_and_the_others_kept() {
+    let new = "## bench store\n\nnew numbers\n";
+    let out = replace_section(DOC, "store", new);
+    assert_eq!(
+        out,
+        "# Benchmarks\n\nIntro.\n\n## bench store\n\nnew numbers\n\n## bench knn\n\nPlaceholder.\n"
+    );
+    // Replacing again changes nothing: the record is idempotent.
+    assert_eq!(replace_section(&out, "store", new), out);
+    // The last section runs to the end of the file.
+    let out = replace_section(DOC, "knn", "## bench knn\n\nk\n");
+    assert!(out.ends_with("| a | b |\n\n## bench knn\n\nk\n"), "{out}");
+    assert!(out.starts_with("# Benchmarks\n\nIntro.\n\n## bench store\n"));
+}
+
+#[test]
+fn a_new_section_is_appended_and_headings_in_output_do_not_end_sections() {
+    let out = replace_section(DOC, "rays", "## bench rays\n\nr\n");
+    assert_eq!(out, format!("{DOC}\n## bench rays\n\nr\n"));
+    // `## ` inside a fenced block is output, not a heading; `## bench rays2` is another
+    // benchmark.
+    let doc = "# B\n\n## bench rays\n\n```text\n## not a heading\n```\n\n## bench rays2\n\nx\n";
+    let out = replace_section(doc, "rays", "## bench rays\n\nnew\n");
+    assert_eq!(out, "# B\n\n## bench rays\n\nnew\n\n## bench rays2\n\nx\n");
+}
+
+#[test]
+fn a_section_holds_command_date_machine_and_fenced_output() {
+    let b = bench(&["bench", "rays", "--runs", "3"]);
+    let s = section(&b, "2024-01-02 03:04 UTC", "2 CPUs", "line `x`\n```\n\n");
+    assert_eq!(
+        s,
+        format!(
+            "## bench rays\n\n\
+             - command: `cargo xtask bench rays --runs 3`\n\
+             - runs: `photonflow bench-rays {} --runs 3` (profile `release-lto`)\n\
+             - date: 2024-01-02 03:04 UTC\n\
+             - machine: 2 CPUs\n\n\
+             ````text\nline `x`\n```\n````\n",
+            flags::DEFAULT_SCENE
+        )
+    );
+    // Arguments the shell would split are quoted.
+    let b = bench(&["bench", "knn", "--label", "a b"]);
+    assert!(section(&b, "", "", "").contains("`cargo xtask bench knn --label 'a b'`"));
+}
+
+/// A whole run with `echo` standing in for photonflow (it prints its arguments), in a scratch
+/// root: the output lands in its section, the rest of the file stays, no temp file is left,
+/// and a failed run records nothing.
+#[cfg(unix)]
+#[test]
+fn a_run_is_recorded_in_its_section() {
+    let root = std::env::temp_dir().join(format!("xtask-bench-{}", std::process::id()));
+    let doc = root.join(benchmarks::DOC);
+    std::fs::create_dir_all(doc.parent().unwrap()).unwrap();
+    std::fs::write(&doc, DOC).unwrap();
+    let b = bench(&["bench", "store", "--photons", "5"]);
+    benchmarks::run(&root, Path::new("echo"), &b).unwrap();
+    let text = std::fs::read_to_string(&doc).unwrap();
+    assert!(text.starts_with("# Benchmarks\n\nIntro.\n\n## bench store\n\n- command: `cargo xtask bench store --photons 5`\n"));
+    assert!(
+        text.contains("\n```text\nbench-store --photons 5\n```\n\n## bench knn\n\nPlaceholder.\n")
+    );
+    assert!(!text.contains("moved from"));
+    let files = std::fs::read_dir(doc.parent().unwrap()).unwrap().count();
+    assert_eq!(files, 1, "a temp file was left behind");
+
+    assert!(benchmarks::run(&root, Path::new("false"), &b).is_err());
+    assert_eq!(std::fs::read_to_string(&doc).unwrap(), text);
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+#[test]
+fn dates_are_utc_calendar_dates() {
+    assert_eq!(utc(0), "1970-01-01 00:00 UTC");
+    assert_eq!(utc(951_782_400), "2000-02-29 00:00 UTC");
+    assert_eq!(utc(951_868_800 + 3_723), "2000-03-01 01:02 UTC");
+    assert_eq!(utc(1_704_067_199), "2023-12-31 23:59 UTC");
+    assert_eq!(utc(4_107_542_400), "2100-03-01 00:00 UTC");
+}
+
+#[test]
+fn the_cpu_model_comes_from_cpuinfo() {
+    let info = "processor\t: 0\nmodel name\t: AMD  EPYC 7763 64-Core Processor\nprocessor\t: 1\n";
+    assert_eq!(
+        cpu_model(info).as_deref(),
+        Some("AMD EPYC 7763 64-Core Processor")
+    );
+    assert_eq!(cpu_model("processor\t: 0\n"), None);
+}
