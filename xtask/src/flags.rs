@@ -5,7 +5,8 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
                          `photonflow <command> --help` lists all options)
 
   render SCENE [--method path|global-direct|final-gather] [--spp N] [--threads N] [--out DIR]
-                      render with a progress bar; writes image.exr, image.png, layers/, image.json.
+                      render with a progress bar; writes image.exr, image.png, layers/, image.json
+                      and scene.toml (the resolved scene: renders the same image again).
                       path: the path-traced reference (--no-caustics leaves out L S+ D light);
                       the photon methods chain trace (or reuse the cache) -> estimate -> composite;
                       without --method: the scene's render.method (default final-gather)
@@ -19,6 +20,9 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
                       worksheet 7's images (box kernel, Silverman, + topological test,
                       + boundary correction) with errors against a path-traced reference,
                       summarised in out/worksheet/README.md
+  composite RUN... --out DIR
+                      combine runs of one view: layers of one name averaged by their counts,
+                      disjoint layers summed (e.g. path --no-caustics + a photon caustic image)
   compare A.exr B.exr [--mask x0,y0,x1,y1]
                       RMSE, relative MSE and mean absolute error of A against reference B
   info SCENE          load a scene and print what it holds
@@ -67,7 +71,8 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
         [] | ["help" | "-h" | "--help", ..] => Ok(Cmd::Help),
         ["gen-scenes"] => Ok(Cmd::GenScenes),
         [
-            cmd @ ("info" | "render" | "compare" | "trace" | "estimate" | "worksheet"),
+            cmd
+            @ ("info" | "render" | "compare" | "composite" | "trace" | "estimate" | "worksheet"),
             rest @ ..,
         ] => Ok(Cmd::Photonflow(
             std::iter::once(*cmd)

@@ -396,30 +396,6 @@ fn run(cmd: Cmd) -> Result<(), String> {
 }
 
 fn info(path: &Path) -> Result<(), String> {
-    let s = load(path)?;
-    let m = s.geometry.mesh();
-    println!("scene      {} ({})", path.display(), s.file.name);
-    println!("triangles  {}", m.len());
-    println!("spheres    {}", s.geometry.spheres().len());
-    println!(
-        "lights     {} emissive triangles, area {:.6}, power {:?}",
-        s.lights.len(),
-        s.light_area(),
-        s.light_power().to_array()
-    );
-    for (name, mat) in s.material_names.iter().zip(&s.materials) {
-        println!("material   {name}: {mat:?}");
-    }
-    let b = s.geometry.bounds();
-    println!(
-        "bounds     {:?} .. {:?}",
-        b.min.to_array(),
-        b.max.to_array()
-    );
-    println!(
-        "camera     {}x{}, vfov {}",
-        s.camera.width, s.camera.height, s.camera.vfov_deg
-    );
-    println!("hash       {:016x}", s.content_hash);
+    print!("{}", pipeline::describe(&load(path)?));
     Ok(())
 }

@@ -134,3 +134,38 @@ pub fn trace(
     let threads = threads.unwrap_or_else(rayon::current_num_threads);
     photon_cache::trace(scene, &settings.emit, cache, threads, force)
 }
+
+/// What a scene holds, for `photonflow info`: triangles, spheres, lights and their power,
+/// materials, bounds, camera, content hash.
+pub fn describe(s: &Scene) -> String {
+    use std::fmt::Write as _;
+    let mut o = String::new();
+    let m = s.geometry.mesh();
+    let _ = writeln!(o, "scene      {} ({})", s.path.display(), s.file.name);
+    let _ = writeln!(o, "triangles  {}", m.len());
+    let _ = writeln!(o, "spheres    {}", s.geometry.spheres().len());
+    let _ = writeln!(
+        o,
+        "lights     {} emissive triangles, area {:.6}, power {:?}",
+        s.lights.len(),
+        s.light_area(),
+        s.light_power().to_array()
+    );
+    for (name, mat) in s.material_names.iter().zip(&s.materials) {
+        let _ = writeln!(o, "material   {name}: {mat:?}");
+    }
+    let b = s.geometry.bounds();
+    let _ = writeln!(
+        o,
+        "bounds     {:?} .. {:?}",
+        b.min.to_array(),
+        b.max.to_array()
+    );
+    let _ = writeln!(
+        o,
+        "camera     {}x{}, vfov {}",
+        s.camera.width, s.camera.height, s.camera.vfov_deg
+    );
+    let _ = writeln!(o, "hash       {:016x}", s.content_hash);
+    o
+}

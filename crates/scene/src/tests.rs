@@ -422,7 +422,7 @@ fn broken_obj_and_mtl_syntax_are_named() {
             ("m.mtl", GOOD_MTL),
         ],
         "a.obj",
-        "",
+        "face vertex index out of bounds",
     );
 }
 

@@ -33,7 +33,17 @@ fn a_photon_is_32_bytes_and_keeps_its_fields() {
         -Vec3::Y,
         7,
     );
-    assert_eq!(bytemuck::bytes_of(&p).len(), 32);
+    // The bytes are the layout the file header names (RECORD_LAYOUT): position, power,
+    // direction, surface, in that order, little-endian. Readers cast, so a reordered field
+    // would silently misread every file.
+    let b = bytemuck::bytes_of(&p);
+    let f32_at = |i: usize| f32::from_le_bytes(b[i..i + 4].try_into().unwrap());
+    let u32_at = |i: usize| u32::from_le_bytes(b[i..i + 4].try_into().unwrap());
+    assert_eq!([f32_at(0), f32_at(4), f32_at(8)], [1.0, 2.0, 3.0]);
+    assert_eq!([f32_at(12), f32_at(16), f32_at(20)], [0.5, 0.25, 0.125]);
+    assert_eq!(u32_at(24), p.dir);
+    assert_eq!(u32_at(28), 7);
+    assert!(crate::RECORD_LAYOUT.starts_with("pos:f32x3,power:f32x3,dir:oct16x2,surface:u32"));
     assert_eq!(p.position(), Vec3::new(1.0, 2.0, 3.0));
     assert_eq!(p.power(), Vec3::new(0.5, 0.25, 0.125));
     assert!((p.direction() - -Vec3::Y).length() < 1e-6);
