@@ -13,10 +13,6 @@ impl Bounds3 {
         max: Vec3::splat(f32::NEG_INFINITY),
     };
 
-    pub fn from_point(p: Vec3) -> Bounds3 {
-        Bounds3 { min: p, max: p }
-    }
-
     pub fn is_empty(&self) -> bool {
         self.min.cmpgt(self.max).any()
     }
@@ -33,18 +29,6 @@ impl Bounds3 {
             min: self.min.min(b.min),
             max: self.max.max(b.max),
         }
-    }
-
-    pub fn diagonal(&self) -> Vec3 {
-        if self.is_empty() {
-            Vec3::ZERO
-        } else {
-            self.max - self.min
-        }
-    }
-
-    pub fn centroid(&self) -> Vec3 {
-        0.5 * (self.min + self.max)
     }
 
     pub fn contains(&self, p: Vec3) -> bool {

@@ -62,12 +62,6 @@ impl Rng {
         (self.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
     }
 
-    /// Uniform in [0, 1) with 53 bits, for tests and f64 work.
-    #[inline]
-    pub fn uniform_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-
     #[inline]
     pub fn uniform2(&mut self) -> [f32; 2] {
         [self.uniform(), self.uniform()]

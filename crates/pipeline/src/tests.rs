@@ -387,3 +387,47 @@ fn boundary_correction_removes_the_darkening_at_an_edge_and_a_corner() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn an_in_memory_stage_sees_the_same_photons_as_the_file_writer() {
+    // Two consumers of one run: the photon file writer and an in-memory collector (what a
+    // k-NN builder or a splatter does with the chunks). Both see every photon, in order.
+    use crate::flow::CollectSink;
+    let scene = cornell();
+    let params = EmitParams {
+        photons: 12_000,
+        ..EmitParams::default()
+    };
+    let d = scratch("collect");
+    let plan = Plan::for_scene(&scene, &params).unwrap();
+    let key = CacheKey::new(&scene, &params);
+    let files: Vec<(MapKind, PathBuf)> = pipeline::planned_kinds(&plan)
+        .into_iter()
+        .map(|k| (k, key.file(&d, k)))
+        .collect();
+    let mut store = StoreSink::create(&files, &|k| key.header(&scene, k)).unwrap();
+    let mut collect = CollectSink::default();
+    let opts = PipelineOptions {
+        threads: 2,
+        chunk: 1000,
+        window: 4,
+    };
+    let stats = flow::run(
+        &scene,
+        &params,
+        &plan,
+        &mut [&mut store as &mut dyn Sink, &mut collect],
+        &opts,
+        &Progress::hidden(),
+    )
+    .unwrap();
+    store.finish(params.photons).unwrap();
+    assert!(stats.max_in_flight <= 4);
+    assert_eq!(collect.0.emitted, params.photons);
+    for (kind, path) in &files {
+        let file = MappedStore::open(path).unwrap();
+        assert!(!collect.0[*kind].is_empty(), "{kind:?}");
+        assert_eq!(file.to_vec(), collect.0[*kind], "{kind:?}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

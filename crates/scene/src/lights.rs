@@ -7,7 +7,7 @@
 //! samplers never own a generator).
 
 use crate::AreaLight;
-use geom::{Hit, Prim, Ray, SurfacePoint, TriMesh};
+use geom::{Prim, Ray, SurfacePoint, TriMesh};
 use glam::{DVec3, Vec3};
 use math::warp::{sample_cosine_hemisphere, sample_uniform_triangle};
 use math::{Distribution1D, Frame};
@@ -247,14 +247,6 @@ impl LightTable {
             return 0.0;
         }
         e.pmf as f32 / e.area * dist2 / cos_light
-    }
-
-    /// [`LightTable::pdf`] for a BSDF-sampled hit, 0 if the hit is not on a light.
-    pub fn pdf_hit(&self, hit: &Hit, from: Vec3) -> f32 {
-        match self.light_of(hit.prim) {
-            Some(i) => self.pdf(i, from, hit.point.p),
-            None => 0.0,
-        }
     }
 
     /// Flux of a photon from light `i` when `photons` paths are emitted in all: the
