@@ -2,7 +2,6 @@
 //! chains them. Errors print one line naming the file and the problem and exit non-zero;
 //! nothing here panics on bad input.
 
-mod bench;
 mod composite;
 
 use clap::{Parser, Subcommand};
@@ -277,7 +276,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
             runs,
             rays,
             compare,
-        } => bench::rays(&scene, runs, rays, compare),
+        } => pipeline::bench::rays(&scene, runs, rays, compare),
         Cmd::Render {
             scene,
             method,
@@ -350,9 +349,9 @@ fn run(cmd: Cmd) -> Result<(), String> {
             scene,
             photons,
             runs,
-        } => bench::photons(&scene, photons, runs),
-        Cmd::BenchStore { photons, dir } => bench::store(photons, &dir),
-        Cmd::BenchKnn { photons, queries } => bench::knn(photons, queries),
+        } => pipeline::bench::photons(&scene, photons, runs),
+        Cmd::BenchStore { photons, dir } => pipeline::bench::store(photons, &dir),
+        Cmd::BenchKnn { photons, queries } => pipeline::bench::knn(photons, queries),
         Cmd::Worksheet {
             scene,
             photons,

@@ -16,6 +16,7 @@
 //!
 //! File IO happens only at paths the caller passes in.
 
+pub mod bench;
 pub mod boundary;
 pub mod flow;
 pub mod gather_cache;

@@ -97,9 +97,9 @@ fn random_rays(geo: &Geometry, count: usize, seed: u64) -> Vec<Ray> {
 /// photon files. Median of `runs`.
 pub fn photons(path: &Path, count: u64, runs: usize) -> Result<(), String> {
     let s = scene::Scene::load(path).map_err(|e| e.to_string())?;
-    let params = pipeline::Settings::new(
+    let params = crate::Settings::new(
         &s,
-        &pipeline::Overrides {
+        &crate::Overrides {
             photons: Some(count),
             ..Default::default()
         },
@@ -141,13 +141,13 @@ pub fn photons(path: &Path, count: u64, runs: usize) -> Result<(), String> {
     for threads in [1usize, 2] {
         let mut rates = Vec::new();
         for _ in 0..runs.max(1) {
-            use pipeline::flow::{self, PipelineOptions, Sink, StoreSink};
-            let key = pipeline::photon_cache::CacheKey::new(&s, &params);
-            let files: Vec<_> = pipeline::photon_cache::planned_kinds(&plan)
+            use crate::flow::{self, PipelineOptions, Sink, StoreSink};
+            let key = crate::photon_cache::CacheKey::new(&s, &params);
+            let files: Vec<_> = crate::photon_cache::planned_kinds(&plan)
                 .into_iter()
                 .map(|k| (k, key.file(&dir, k)))
                 .collect();
-            let progress = pipeline::progress::Progress::hidden();
+            let progress = crate::progress::Progress::hidden();
             let mut store = StoreSink::create(&files, &|k| key.header(&s, k))?;
             let stats = flow::run(
                 &s,
