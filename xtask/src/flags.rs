@@ -22,7 +22,7 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
                       summarised in out/worksheet/README.md
   composite RUN... --out DIR
                       combine runs of one view: layers of one name averaged by their counts,
-                      disjoint layers summed (e.g. path --no-caustics + a photon caustic image)
+                      disjoint layers summed (independent runs: other --seed)
   compare A.exr B.exr [--mask x0,y0,x1,y1]
                       RMSE, relative MSE and mean absolute error of A against reference B
   info SCENE          load a scene and print what it holds

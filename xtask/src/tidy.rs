@@ -1,6 +1,7 @@
 //! Repository rules that a compiler does not check, run by plain `cargo test` (rust-analyzer's
 //! `tidy.rs` habit):
-//! - dependencies between our crates follow the table in `ARCHITECTURE.md`: vocabulary at the
+//! - dependencies between our crates follow the table below (`ALLOWED`, described in
+//!   `ARCHITECTURE.md`): vocabulary at the
 //!   bottom, stage crates independent of each other, the binary on top;
 //! - every crate opts into the workspace lints;
 //! - no ignore or should-panic attributes on tests: a test that cannot fail, or hides a known

@@ -145,6 +145,7 @@ impl Composite {
             width: self.width,
             height: self.height,
             layers,
+            seed: None,
         }
     }
 
@@ -268,6 +269,27 @@ pub fn composite(inputs: Vec<Input>) -> Result<Composite, String> {
                 "{}: size {}x{} differs from {width}x{height} of {}",
                 input.label, m.width, m.height, first.label
             ));
+        }
+    }
+
+    // Runs averaged into one layer must be independent: one seed means shared random streams.
+    for (i, a) in inputs.iter().enumerate() {
+        for b in &inputs[..i] {
+            let (Some(sa), Some(sb)) = (a.meta.seed, b.meta.seed) else {
+                continue;
+            };
+            let shared = a
+                .meta
+                .layers
+                .iter()
+                .find(|l| b.meta.layers.iter().any(|o| o.name == l.name));
+            if let (true, Some(l)) = (sa == sb, shared) {
+                return Err(format!(
+                    "{}: seed {sa} is also the seed of {}, and both estimate layer '{}': runs \
+                     with one seed share their random numbers (render again with --seed)",
+                    a.label, b.label, l.name
+                ));
+            }
         }
     }
 

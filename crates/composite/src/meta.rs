@@ -130,6 +130,9 @@ pub struct Meta {
     pub height: usize,
     /// Sorted by name by [`Meta::from_json`]; any order is accepted.
     pub layers: Vec<LayerMeta>,
+    /// The seed of the run's random streams, if it had one (a composite has none). Two runs
+    /// with one seed share their random numbers: they are not independent estimates.
+    pub seed: Option<u64>,
 }
 
 fn count_of(v: &Value, what: &str) -> Result<f64, String> {
@@ -266,11 +269,19 @@ impl Meta {
             });
         }
         layers.sort_by(|a, b| a.name.cmp(&b.name));
+        let seed = match obj.get("seed") {
+            None | Some(Value::Null) => None,
+            Some(v) => Some(
+                v.as_u64()
+                    .ok_or_else(|| format!("seed {v} is not a non-negative integer"))?,
+            ),
+        };
         let meta = Meta {
             view_hash,
             width,
             height,
             layers,
+            seed,
         };
         meta.validate()?;
         Ok(meta)

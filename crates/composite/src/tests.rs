@@ -37,6 +37,7 @@ fn meta(count: f64, kind: CountKind, layers: &[(&str, &[Class])]) -> Meta {
                 count_kind: kind,
             })
             .collect(),
+        seed: None,
     }
 }
 
@@ -663,4 +664,27 @@ fn a_composite_can_be_composited_again() {
             }
         }
     }
+}
+
+#[test]
+fn runs_sharing_a_seed_are_not_averaged() {
+    let seeded = |label: &str, seed: u64, rgb: [f32; 3]| {
+        let mut i = direct(label, 2.0, rgb);
+        i.meta.seed = Some(seed);
+        i
+    };
+    refused(
+        vec![seeded("a", 7, [1.0; 3]), seeded("b", 7, [2.0; 3])],
+        "a",
+        "seed 7",
+    );
+    // Distinct seeds are independent runs: averaged.
+    let c = composite(vec![seeded("a", 7, [1.0; 3]), seeded("b", 8, [2.0; 3])]).unwrap();
+    assert_eq!(c.image.get(0, 0), [1.5; 3]);
+    // One seed on disjoint layers is fine: nothing is averaged.
+    let mut e = seeded("e", 7, [1.0; 3]);
+    e.meta.layers[0].name = "emitted".into();
+    e.meta.layers[0].classes = vec![Emitted];
+    e.layers[0].0 = "emitted".into();
+    composite(vec![seeded("a", 7, [1.0; 3]), e]).unwrap();
 }

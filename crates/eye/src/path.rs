@@ -5,7 +5,7 @@ use bsdf::TransportMode;
 use geom::Ray;
 use glam::Vec3;
 use math::{Frame, Rng, power_heuristic};
-use scene::{LightTable, Scene, sides_agree};
+use scene::{Scene, sides_agree};
 
 /// Which family of light paths a contribution belongs to (Heckbert's notation, read from the
 /// light: `L` light, `S` specular (delta) bounce, `D` non-delta bounce, `E` eye). The parts
@@ -116,18 +116,6 @@ const MAX_SURVIVAL: f32 = 0.95;
 impl<'a> PathTracer<'a> {
     pub fn new(scene: &'a Scene, opts: PathOptions) -> PathTracer<'a> {
         PathTracer { scene, opts }
-    }
-
-    pub fn scene(&self) -> &Scene {
-        self.scene
-    }
-
-    pub fn lights(&self) -> &LightTable {
-        &self.scene.light_table
-    }
-
-    pub fn options(&self) -> PathOptions {
-        self.opts
     }
 
     /// Radiance arriving along `-ray.d` at `ray.o`, estimated by one path whose random

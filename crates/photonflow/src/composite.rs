@@ -13,6 +13,9 @@ use std::path::{Path, PathBuf};
 /// An input is a run's output directory or its `image.exr` (or `image.json`). Nothing is
 /// written unless every input reads and the inputs combine.
 pub fn run(inputs: &[PathBuf], out: &Path, exposure: f32) -> Result<(), String> {
+    if !exposure.is_finite() {
+        return Err(format!("--exposure {exposure} must be finite"));
+    }
     if inputs.is_empty() {
         return Err("composite: no inputs given".into());
     }

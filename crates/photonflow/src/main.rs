@@ -111,6 +111,9 @@ enum Cmd {
     /// Trace the photon sets a scene needs into the cache (or reuse them).
     Trace {
         scene: PathBuf,
+        /// Seed of every random stream (default: the scene file's `seed`).
+        #[arg(long)]
+        seed: Option<u64>,
         /// Photon paths to emit (default: the scene's [photons] table).
         #[arg(long)]
         photons: Option<u64>,
@@ -165,6 +168,10 @@ struct ImageArgs {
 /// Photon-mapping settings shared by `estimate` and `render`.
 #[derive(clap::Args)]
 struct PhotonArgs {
+    /// Seed of every random stream (default: the scene file's `seed`); recorded in the
+    /// outputs' `scene.toml` and `image.json`.
+    #[arg(long)]
+    seed: Option<u64>,
     /// Photon paths emitted (default: the scene's [photons] table).
     #[arg(long)]
     photons: Option<u64>,
@@ -213,18 +220,24 @@ impl PhotonArgs {
             photons: self.photons,
             k: self.k,
             kernel: self.kernel,
-            topo: self.topo,
-            drop_kth: self.drop_kth,
-            boundary: self.boundary,
+            topo: self.topo.map(Some),
+            drop_kth: self.drop_kth.then_some(true),
+            boundary: self.boundary.then_some(true),
             gather_rays: self.gather_rays,
             gather_cache: self.gather_cache,
-            no_caustics: false,
+            caustics: None,
         }
     }
 }
 
-fn load(path: &Path) -> Result<Scene, String> {
-    Scene::load(path).map_err(|e| e.to_string())
+/// The one load of a command's scene, with `--seed` applied.
+fn load(path: &Path, seed: Option<u64>) -> Result<Scene, String> {
+    Scene::load_with(path, |f| {
+        if let Some(s) = seed {
+            f.seed = s;
+        }
+    })
+    .map_err(|e| e.to_string())
 }
 
 /// `render` and `estimate`: the one path through the library, then a summary line.
@@ -284,9 +297,9 @@ fn run(cmd: Cmd) -> Result<(), String> {
             image,
             no_caustics,
         } => {
-            let s = load(&scene)?;
+            let s = load(&scene, photon.seed)?;
             let overrides = Overrides {
-                no_caustics,
+                caustics: no_caustics.then_some(false),
                 ..photon.overrides(method, image.spp)
             };
             render(
@@ -309,17 +322,19 @@ fn run(cmd: Cmd) -> Result<(), String> {
             photon,
             image,
         } => {
-            if method == Some(Method::Path) {
-                return Err(
-                    "estimate reads photon maps: use `render --method path` for the path tracer"
-                        .into(),
-                );
+            let reads_maps = |m: Method| pipeline::methods::spec(m).photon_maps;
+            if let Some(m) = method
+                && !reads_maps(m)
+            {
+                return Err(format!(
+                    "estimate reads photon maps: use `render --method {m}` for `{m}`"
+                ));
             }
-            let s = load(&scene)?;
-            // A scene whose default is the path tracer still gets a photon method here.
+            let s = load(&scene, photon.seed)?;
+            // A scene whose default reads no photon maps still gets a photon method here.
             let method = method.unwrap_or(match s.render().method {
-                Method::Path => Method::GlobalDirect,
-                m => m,
+                m if reads_maps(m) => m,
+                _ => Method::GlobalDirect,
             });
             render(
                 &s,
@@ -362,7 +377,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
             cache,
             threads,
         } => {
-            let s = load(&scene)?;
+            let s = load(&scene, None)?;
             pipeline::worksheet::run(
                 &s,
                 &pipeline::worksheet::WorksheetArgs {
@@ -379,12 +394,13 @@ fn run(cmd: Cmd) -> Result<(), String> {
         }
         Cmd::Trace {
             scene,
+            seed,
             photons,
             cache,
             threads,
             force,
         } => {
-            let s = load(&scene)?;
+            let s = load(&scene, seed)?;
             let overrides = Overrides {
                 photons,
                 ..Overrides::default()
@@ -395,6 +411,6 @@ fn run(cmd: Cmd) -> Result<(), String> {
 }
 
 fn info(path: &Path) -> Result<(), String> {
-    print!("{}", pipeline::describe(&load(path)?));
+    print!("{}", pipeline::describe(&load(path, None)?));
     Ok(())
 }

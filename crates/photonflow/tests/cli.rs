@@ -473,7 +473,8 @@ fn composite_averages_runs_by_their_counts_and_refuses_other_views() {
     let dir = Scratch::new("composite", &[]);
     let scene = "scenes/corner/corner.toml";
     let mut outs = Vec::new();
-    for spp in ["1", "3"] {
+    // Independent runs: another seed each (one seed would share random streams).
+    for (spp, seed) in [("1", "11"), ("3", "12")] {
         let out = dir.0.join(spp);
         let o = photonflow(&[
             "render",
@@ -482,6 +483,8 @@ fn composite_averages_runs_by_their_counts_and_refuses_other_views() {
             "path",
             "--spp",
             spp,
+            "--seed",
+            seed,
             "--out",
             out.to_str().unwrap(),
         ]);
@@ -508,6 +511,8 @@ fn composite_averages_runs_by_their_counts_and_refuses_other_views() {
         }
     }
     assert!(worst < 1e-5, "relative error {worst}");
+    let json = std::fs::read_to_string(outs[1].join("image.json")).unwrap();
+    assert!(json.contains("\"seed\": 12"), "{json}");
     // In the other order: the same bytes.
     let out2 = dir.0.join("sum2");
     let o = photonflow(&[
@@ -535,6 +540,7 @@ fn composite_averages_runs_by_their_counts_and_refuses_other_views() {
     .replace("obj = \"corner.obj\"", &format!("obj = {obj:?}"))
     .replace("vfov = 60.0", "vfov = 50.0");
     let narrow = dir.0.join("narrow.toml");
+    // (The same seed as the first run, so only the view can be what is refused.)
     std::fs::write(&narrow, text).unwrap();
     let other = dir.0.join("other");
     let o = photonflow(&[
@@ -544,6 +550,8 @@ fn composite_averages_runs_by_their_counts_and_refuses_other_views() {
         "path",
         "--spp",
         "1",
+        "--seed",
+        "11",
         "--out",
         other.to_str().unwrap(),
     ]);

@@ -88,8 +88,8 @@ impl Sink for ChannelSink {
     }
 }
 
-/// Collects every chunk in memory (the in-process consumer of tests and of photon maps built
-/// without a file).
+/// Collects every chunk in memory: an in-process consumer (a k-NN builder that needs no
+/// photon file, or a test).
 #[derive(Default)]
 pub struct CollectSink(pub Traced);
 

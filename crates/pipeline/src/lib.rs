@@ -1,6 +1,7 @@
 //! `pipeline`: the stages wired together as a library, so that everything a command does can
 //! be called (and tested) in one process. The binary `photonflow` parses flags, picks paths
-//! and calls [`render`] or [`trace`]; the end-to-end tests call the same functions.
+//! and calls [`render`] or [`trace`]; the end-to-end tests in `tests/` call the library the
+//! same way.
 //!
 //! - [`settings`]: the scene file's `[photons]` and `[estimate]` tables, typed, with the
 //!   command line's overrides; the resolved scene file every output directory holds.
@@ -97,9 +98,18 @@ pub fn render(scene: &Scene, req: &RenderRequest) -> Result<RenderSummary, Strin
     if !req.exposure.is_finite() {
         return Err(format!("--exposure {} must be finite", req.exposure));
     }
-    let progress = Progress::new(&settings.method.name(), methods::work(&run), "samples");
-    let rendered = methods::render(&run, &|n| progress.inc(n))?;
-    progress.finish();
+    // The bar starts with the eye pass's first finished tile, so tracing and loading photons
+    // (which report on their own) neither share the terminal line nor its rate.
+    let bar = std::sync::OnceLock::new();
+    let work = methods::work(&run);
+    let name = settings.method.name();
+    let rendered = methods::render(&run, &|n| {
+        bar.get_or_init(|| Progress::new(&name, work, "samples"))
+            .inc(n)
+    })?;
+    if let Some(p) = bar.into_inner() {
+        p.finish();
+    }
     let seconds = t0.elapsed().as_secs_f64();
     let (image, metrics) = output::write(
         scene,

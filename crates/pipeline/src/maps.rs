@@ -59,13 +59,22 @@ impl Maps<'_> {
             return (Vec3::ZERO, 0.0);
         };
         let e = m.irradiance_hinted(p, n, params, hint, scratch);
+        if scratch.is_empty() {
+            return (e, 0.0);
+        }
+        // The radius the estimate used: the hint's k-th distance, or with fewer than k
+        // photons in reach (and no finite r_max) the farthest one found.
+        let r = if hint.r.is_finite() {
+            hint.r
+        } else {
+            scratch.iter().map(|nb| nb.d2).fold(0.0f32, f32::max).sqrt()
+        };
         match (kind, self.boundary) {
-            // The hint now holds the radius the estimate used.
-            (MapKind::Global, Some(scene)) if !scratch.is_empty() => {
-                let mass = kernel_mass_on_surface(scene, p, n, hint.r, params);
-                (e / mass.max(MIN_MASS), hint.r)
+            (MapKind::Global, Some(scene)) => {
+                let mass = kernel_mass_on_surface(scene, p, n, r, params);
+                (e / mass.max(MIN_MASS), r)
             }
-            _ => (e, hint.r),
+            _ => (e, r),
         }
     }
 

@@ -75,14 +75,19 @@ pub fn write(
         "image_hash": format!("{:016x}", scene.image_hash),
         "photon_hash": format!("{:016x}", scene.photon_hash),
         "view_hash": format!("{:016x}", scene.view_hash),
+        "settings_hash": format!("{:016x}", settings.hash(scene)),
         "method": settings.method.name(),
         "label": o.label,
         "seed": scene.seed(),
         "width": image.width,
         "height": image.height,
-        "count": r.count,
-        "count_kind": r.count_kind.name(),
         "layers": r.layers.iter().map(|l| (l.name.clone(), serde_json::json!(l.classes)))
+            .collect::<serde_json::Map<_, _>>(),
+        "layer_counts": r.layers.iter()
+            .map(|l| (l.name.clone(), serde_json::json!({
+                "count": l.count,
+                "count_kind": l.count_kind.name(),
+            })))
             .collect::<serde_json::Map<_, _>>(),
         "threads": o.threads,
         "time_total_s": o.seconds,
@@ -95,6 +100,15 @@ pub fn write(
         "mean_reference": metrics.as_ref().map(|m| m.mean_b),
     });
     if let Some(obj) = json.as_object_mut() {
+        // One count for the whole run where every layer shares it (composite reads either).
+        if let Some(first) = r.layers.first()
+            && r.layers
+                .iter()
+                .all(|l| (l.count, l.count_kind) == (first.count, first.count_kind))
+        {
+            obj.insert("count".into(), first.count.into());
+            obj.insert("count_kind".into(), first.count_kind.name().into());
+        }
         for (k, v) in &r.info {
             obj.insert(k.clone(), v.clone());
         }
@@ -104,6 +118,19 @@ pub fn write(
     let out = o.out;
     std::fs::create_dir_all(out.join("layers"))
         .map_err(|e| format!("{}: cannot create output directory: {e}", out.display()))?;
+    // A directory written before holds files this run may not replace (another method's
+    // layers, a plan): remove them first, so `image.json`, written last, never describes
+    // a mix of two runs, and a run that fails half-way leaves no `image.json` behind.
+    for name in ["image.json", "scene.toml", "plan.txt"] {
+        remove_if_present(&out.join(name))?;
+    }
+    if let Ok(dir) = std::fs::read_dir(out.join("layers")) {
+        for e in dir.flatten() {
+            if e.path().extension().is_some_and(|x| x == "exr") {
+                remove_if_present(&e.path())?;
+            }
+        }
+    }
     film::write_exr(out.join("image.exr"), &image).map_err(|e| e.to_string())?;
     film::write_png(out.join("image.png"), &image, &tone).map_err(|e| e.to_string())?;
     for l in &r.layers {
@@ -113,12 +140,20 @@ pub fn write(
     let w = |name: &str, bytes: &[u8]| {
         film::write_atomic(&out.join(name), bytes).map_err(|e| e.to_string())
     };
-    w("image.json", json_text.as_bytes())?;
     w("scene.toml", scene_text.as_bytes())?;
     if let Some(plan) = &r.plan {
         w("plan.txt", plan.to_string().as_bytes())?;
     }
+    w("image.json", json_text.as_bytes())?;
     Ok((image, metrics))
+}
+
+fn remove_if_present(p: &Path) -> Result<(), String> {
+    match std::fs::remove_file(p) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(format!("{}: cannot replace: {e}", p.display())),
+    }
 }
 
 /// Error metrics of image `a` against reference `b` (linear EXR files), inside `mask`.

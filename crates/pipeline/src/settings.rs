@@ -64,7 +64,7 @@ impl Default for EstimateSettings {
     }
 }
 
-/// Command-line overrides of scene-file settings; `None`/`false` leaves the file's value.
+/// Command-line overrides of scene-file settings; `None` leaves the file's value.
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
     pub method: Option<Method>,
@@ -74,13 +74,14 @@ pub struct Overrides {
     /// Global-map estimate.
     pub k: Option<usize>,
     pub kernel: Option<Kernel>,
-    pub topo: Option<f32>,
-    pub drop_kth: bool,
-    pub boundary: bool,
+    /// `Some(None)` switches the topological test off.
+    pub topo: Option<Option<f32>>,
+    pub drop_kth: Option<bool>,
+    pub boundary: Option<bool>,
     pub gather_rays: Option<u32>,
     pub gather_cache: Option<usize>,
-    /// Leave caustic paths out of the path tracer.
-    pub no_caustics: bool,
+    /// Whether the path tracer follows caustic paths (`render.caustics`).
+    pub caustics: Option<bool>,
 }
 
 /// Everything a run needs besides the scene's geometry.
@@ -108,13 +109,23 @@ impl Settings {
         if let Some(n) = o.photons {
             emit.photons = n;
         }
+        let photon_maps = crate::methods::spec(method).photon_maps;
         if let Some(spp) = o.spp {
-            match method {
-                Method::Path => render.spp = spp,
-                _ => estimate.spp = spp,
+            if photon_maps {
+                estimate.spp = spp;
+            } else {
+                render.spp = spp;
             }
         }
-        render.caustics &= !o.no_caustics;
+        if let Some(c) = o.caustics {
+            if photon_maps {
+                return Err(format!(
+                    "--no-caustics applies to the path tracer; {method} takes caustics from \
+                     photons"
+                ));
+            }
+            render.caustics = c;
+        }
         let g = &mut estimate.global;
         if let Some(k) = o.k {
             g.k = k;
@@ -122,11 +133,15 @@ impl Settings {
         if let Some(kern) = o.kernel {
             g.kernel = kern;
         }
-        if let Some(eps) = o.topo {
-            g.topo = Some(eps);
+        if let Some(topo) = o.topo {
+            g.topo = topo;
         }
-        g.drop_kth |= o.drop_kth;
-        estimate.boundary |= o.boundary;
+        if let Some(d) = o.drop_kth {
+            g.drop_kth = d;
+        }
+        if let Some(b) = o.boundary {
+            estimate.boundary = b;
+        }
         if let Some(r) = o.gather_rays {
             estimate.final_gather.rays = r;
         }
@@ -141,6 +156,30 @@ impl Settings {
         };
         s.validate().map_err(err)?;
         Ok(s)
+    }
+
+    /// Samples per pixel of the method.
+    pub fn spp(&self) -> u32 {
+        if crate::methods::spec(self.method).photon_maps {
+            self.estimate.spp
+        } else {
+            self.render.spp
+        }
+    }
+
+    /// What an image made with these settings depends on: the scene's view and seed
+    /// (`image_hash` without the file's `[render]`) and every setting after the flags. Equal
+    /// hashes, equal images (the worksheet reuses its reference on it).
+    pub fn hash(&self, scene: &Scene) -> u64 {
+        let text = format!(
+            "{:016x} {} {:?} {:?} {:?}",
+            scene.view_hash,
+            scene.seed(),
+            toml::to_string(&self.render).unwrap_or_default(),
+            toml::to_string(&self.emit).unwrap_or_default(),
+            toml::to_string(&self.estimate).unwrap_or_default(),
+        );
+        scene::fnv1a64(text.as_bytes())
     }
 
     fn validate(&self) -> Result<(), String> {

@@ -36,16 +36,20 @@ struct Variant {
 pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
     std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
 
-    // 1. The path-traced reference, reused when it was made from this scene at >= the spp.
+    // 1. The path-traced reference, reused when it was made with exactly these settings.
     let ref_dir = a.out.join("reference");
     let reference_json = ref_dir.join("image.json");
+    let reference_overrides = Overrides {
+        method: Some(scene::Method::Path),
+        spp: Some(a.reference_spp),
+        caustics: Some(true),
+        ..Overrides::default()
+    };
+    let want = crate::Settings::new(scene, &reference_overrides)?.hash(scene);
     let reusable = std::fs::read_to_string(&reference_json)
         .ok()
         .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-        .is_some_and(|j| {
-            j["image_hash"] == format!("{:016x}", scene.image_hash)
-                && j["spp"].as_u64().unwrap_or(0) >= a.reference_spp as u64
-        });
+        .is_some_and(|j| j["settings_hash"] == format!("{want:016x}"));
     if reusable {
         println!("reference: reusing {}", ref_dir.display());
     } else {
@@ -53,11 +57,7 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
         crate::render(
             scene,
             &RenderRequest {
-                overrides: Overrides {
-                    method: Some(scene::Method::Path),
-                    spp: Some(a.reference_spp),
-                    ..Overrides::default()
-                },
+                overrides: reference_overrides,
                 cache: &a.cache,
                 photons: Photons::CacheOnly,
                 threads: a.threads,
@@ -168,8 +168,10 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
                     spp: Some(1),
                     k: Some(a.k),
                     kernel: Some(v.kernel),
-                    topo: v.topo,
-                    boundary: v.boundary,
+                    // Every knob a variant names is set, whatever the scene file says.
+                    topo: Some(v.topo),
+                    boundary: Some(v.boundary),
+                    drop_kth: Some(false),
                     ..Overrides::default()
                 },
                 cache: &a.cache,
@@ -223,7 +225,7 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
          boundary bias show), and MAE at full resolution. The reference's own noise still \
          adds a floor to each RMSE: compare the rows with each other.\n",
         ref_meta["spp"].as_u64().unwrap_or(a.reference_spp as u64),
-        ref_meta["time_s"].as_f64().unwrap_or(0.0)
+        ref_meta["time_render_s"].as_f64().unwrap_or(0.0)
     );
     let _ = writeln!(
         md,
@@ -264,7 +266,8 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
          - topological test: eps = {} (photons within about {:.1} degrees of the tangent plane)\n\
          - 1 sample per pixel through the pixel centre's jittered position; tone map gamma 1.8\n\
          - each directory holds `image.exr` (linear), `image.png`, `layers/`, `image.json` \
-         (all settings and timings) and `plan.txt` (the effects plan)",
+         (all settings and timings), `scene.toml` (the resolved scene: renders the image again) \
+         and `plan.txt` (the effects plan)",
         a.photons,
         a.k,
         a.topo,

@@ -83,20 +83,39 @@ impl Scene {
 
     /// Load a scene file and every file it names.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        Scene::load_with(path, |_| {})
+    }
+
+    /// [`Scene::load`], with `edit` applied to the parsed file before anything is built or
+    /// hashed (the command line's `--seed`, say): the scene is still loaded once.
+    pub fn load_with(
+        path: impl AsRef<Path>,
+        edit: impl FnOnce(&mut SceneFile),
+    ) -> Result<Scene, SceneError> {
         let path = path.as_ref();
         let text = std::fs::read_to_string(path)
             .map_err(|e| SceneError::new(path, format!("cannot read scene file: {e}")))?;
-        Scene::from_toml(path, &text)
+        Scene::from_toml_with(path, &text, edit)
     }
 
     /// Parse scene text as if it were read from `path` (mesh paths are relative to it).
     pub fn from_toml(path: &Path, text: &str) -> Result<Scene, SceneError> {
-        let file: SceneFile = toml::from_str(text).map_err(|e| {
+        Scene::from_toml_with(path, text, |_| {})
+    }
+
+    /// [`Scene::from_toml`] with `edit` applied to the parsed file first.
+    pub fn from_toml_with(
+        path: &Path,
+        text: &str,
+        edit: impl FnOnce(&mut SceneFile),
+    ) -> Result<Scene, SceneError> {
+        let mut file: SceneFile = toml::from_str(text).map_err(|e| {
             SceneError::new(
                 path,
                 format!("malformed scene file: {}", e.message()) + &location(text, e.span()),
             )
         })?;
+        edit(&mut file);
         // The builder hashes the files the scene names; the scene text joins per use below.
         let mut hash = Fnv::new();
         let mut scene = Builder::new(path, &file, &mut hash).build(file.clone())?;
@@ -139,6 +158,8 @@ impl Scene {
         let mut all = Fnv::new();
         all.write(&files.to_le_bytes());
         all.write(text.as_bytes());
+        // An edit after parsing (a flag) changes the content too.
+        all.write(toml::to_string(&file).unwrap_or_default().as_bytes());
         scene.content_hash = all.finish();
         Ok(scene)
     }

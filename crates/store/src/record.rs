@@ -39,10 +39,6 @@ impl<T> PerKind<T> {
     pub fn iter(&self) -> impl Iterator<Item = (MapKind, &T)> {
         MapKind::ALL.into_iter().zip(self.0.iter())
     }
-
-    pub fn map<U>(self, f: impl FnMut(T) -> U) -> PerKind<U> {
-        PerKind(self.0.map(f))
-    }
 }
 
 impl<T> std::ops::Index<MapKind> for PerKind<T> {

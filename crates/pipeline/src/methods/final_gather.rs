@@ -48,19 +48,25 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     );
     info.insert("time_gather_cache_s".into(), t_cache.into());
     info.insert("time_render_s".into(), seconds.into());
+    let (photons, spp_count) = (run.settings.emit.photons, spp as u64);
     Ok(Rendered {
+        // Emission and next-event estimation use no photons: weighed by samples; the layers
+        // read from photon maps by photon paths.
         layers: super::layers(
             &film,
             spp,
             &[
-                ("emitted", &["emitted"]),
-                ("direct", &["direct"]),
-                ("caustic", &["caustic"]),
-                ("indirect", &["indirect", "caustic_indirect"]),
+                ("emitted", &["emitted"], spp_count, CountKind::Spp),
+                ("direct", &["direct"], spp_count, CountKind::Spp),
+                ("caustic", &["caustic"], photons, CountKind::PhotonPaths),
+                (
+                    "indirect",
+                    &["indirect", "caustic_indirect"],
+                    photons,
+                    CountKind::PhotonPaths,
+                ),
             ],
-        ),
-        count: run.settings.emit.photons,
-        count_kind: CountKind::PhotonPaths,
+        )?,
         plan: Some(inputs.plan),
         info,
     })

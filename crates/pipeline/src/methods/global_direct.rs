@@ -13,20 +13,21 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     let seconds = t0.elapsed().as_secs_f64();
     let mut info = super::photon_info(run, &inputs);
     info.insert("time_render_s".into(), seconds.into());
+    let photons = run.settings.emit.photons;
     Ok(Rendered {
         layers: super::layers(
             &film,
             spp,
             &[
-                ("emitted", &["emitted"]),
+                ("emitted", &["emitted"], spp as u64, CountKind::Spp),
                 (
                     "global",
                     &["direct", "indirect", "caustic", "caustic_indirect"],
+                    photons,
+                    CountKind::PhotonPaths,
                 ),
             ],
-        ),
-        count: run.settings.emit.photons,
-        count_kind: CountKind::PhotonPaths,
+        )?,
         plan: Some(inputs.plan),
         info,
     })

@@ -1,5 +1,5 @@
-//! The methods, one file each, behind one dispatch: [`render`] matches `scene::Method` and
-//! nothing else does. A method gets a [`Run`] (the scene, its settings, where photon sets are
+//! The methods, one file each, behind one dispatch: [`spec`] matches `scene::Method` and
+//! nothing else does; everything else asks the [`MethodSpec`] it returns. A method gets a [`Run`] (the scene, its settings, where photon sets are
 //! cached and whether it may trace them) and returns [`Rendered`] layers, each tagged with
 //! the light-path classes it estimates so that layers of separate runs can be composited
 //! without counting a path twice.
@@ -62,20 +62,21 @@ impl Run<'_> {
     }
 }
 
-/// One layer of an image: its name, the light-path classes ([`CLASSES`]) it estimates, and
-/// its pixels (already divided by the sample count).
+/// One layer of an image: its name, the light-path classes ([`CLASSES`]) it estimates, its
+/// pixels (already divided by the sample count), and its weight when runs are composited:
+/// samples per pixel for layers the eye pass estimates alone, photon paths for layers made
+/// from photons.
 pub struct Layer {
     pub name: String,
     pub classes: Vec<&'static str>,
     pub image: Image,
+    pub count: u64,
+    pub count_kind: CountKind,
 }
 
 /// What a method made.
 pub struct Rendered {
     pub layers: Vec<Layer>,
-    /// The run's weight when runs are composited, and what it counts.
-    pub count: u64,
-    pub count_kind: CountKind,
     /// The effects plan, for photon methods.
     pub plan: Option<Plan>,
     /// Method-specific facts for `image.json` (settings used, photon counts, timings).
@@ -99,16 +100,35 @@ impl CountKind {
     }
 }
 
+/// What the rest of the program needs to know of a method.
+pub struct MethodSpec {
+    pub render: RenderFn,
+    /// It reads photon maps: `estimate` may run it from cached photon sets, and its samples
+    /// per pixel are `[estimate] spp` (else `[render] spp`).
+    pub photon_maps: bool,
+}
+
+type RenderFn = fn(&Run, &(dyn Fn(u64) + Sync)) -> Result<Rendered, String>;
+
+/// The one `match` on `scene::Method`.
+pub fn spec(method: Method) -> MethodSpec {
+    let (render, photon_maps): (RenderFn, bool) = match method {
+        Method::Path => (path::render, false),
+        Method::GlobalDirect => (global_direct::render, true),
+        Method::FinalGather => (final_gather::render, true),
+    };
+    MethodSpec {
+        render,
+        photon_maps,
+    }
+}
+
 /// Runs the method the settings name.
 pub fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
     if run.threads == Some(0) {
         return Err("--threads must be at least 1".into());
     }
-    match run.settings.method {
-        Method::Path => path::render(run, progress),
-        Method::GlobalDirect => global_direct::render(run, progress),
-        Method::FinalGather => final_gather::render(run, progress),
-    }
+    (spec(run.settings.method).render)(run, progress)
 }
 
 /// Total work units (samples) of a run, for a progress bar.
@@ -117,23 +137,27 @@ pub fn work(run: &Run) -> u64 {
         run.scene.camera.width as u64,
         run.scene.camera.height as u64,
     );
-    let spp = match run.settings.method {
-        Method::Path => run.settings.render.spp,
-        _ => run.settings.estimate.spp,
-    };
-    w * h * spp as u64
+    w * h * run.settings.spp() as u64
 }
 
-/// The film's layers divided by `spp`, tagged with their classes.
-pub(crate) fn layers(film: &Film, spp: u32, classes: &[(&str, &[&'static str])]) -> Vec<Layer> {
-    classes
+/// How one film layer is described: name, classes, count, count kind.
+pub(crate) type LayerSpec<'a> = (&'a str, &'a [&'static str], u64, CountKind);
+
+/// The film's layers divided by `spp`, tagged with their classes and counts. A layer the film
+/// lacks is an error (an image silently missing light is worse than none).
+pub(crate) fn layers(film: &Film, spp: u32, specs: &[LayerSpec]) -> Result<Vec<Layer>, String> {
+    specs
         .iter()
-        .filter_map(|(name, cls)| {
-            let img = film.layer(name)?.resolve(Normalize::Constant(spp as f64));
-            Some(Layer {
+        .map(|&(name, cls, count, count_kind)| {
+            let layer = film
+                .layer(name)
+                .ok_or_else(|| format!("the eye pass wrote no `{name}` layer"))?;
+            Ok(Layer {
                 name: name.to_string(),
                 classes: cls.to_vec(),
-                image: img,
+                image: layer.resolve(Normalize::Constant(spp as f64)),
+                count,
+                count_kind,
             })
         })
         .collect()

@@ -1,7 +1,7 @@
 //! `path`: the independent path-traced reference (`eye::render`), `render.spp` samples per
 //! pixel, caustic paths left out when `render.caustics` is off.
 
-use super::{CountKind, Layer, Rendered, Run};
+use super::{CountKind, Layer, LayerSpec, Rendered, Run};
 use eye::Part;
 
 pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
@@ -19,11 +19,18 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
         .into_iter()
         .filter(|p| r.caustics || !p.is_caustic())
         .collect();
-    let classes: Vec<(&str, &[&'static str])> = parts
+    let specs: Vec<LayerSpec> = parts
         .iter()
-        .map(|p| (p.name(), std::slice::from_ref(&super::CLASSES[*p as usize])))
+        .map(|p| {
+            (
+                p.name(),
+                std::slice::from_ref(&super::CLASSES[*p as usize]),
+                r.spp as u64,
+                CountKind::Spp,
+            )
+        })
         .collect();
-    let layers: Vec<Layer> = super::layers(&film, r.spp, &classes);
+    let layers: Vec<Layer> = super::layers(&film, r.spp, &specs)?;
     let (w, h) = (
         run.scene.camera.width as u64,
         run.scene.camera.height as u64,
@@ -43,8 +50,6 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     }
     Ok(Rendered {
         layers,
-        count: r.spp as u64,
-        count_kind: CountKind::Spp,
         plan: None,
         info,
     })
