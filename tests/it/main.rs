@@ -5,6 +5,10 @@
 //!   the light under the ceiling is reachable, camera rays behave).
 //! - `photons`: photon flux against the path tracer (caustic flux under the glass sphere) and
 //!   against the light power (closed furnace box).
+//! - `photon_maps`: the photon-map methods through the pipeline library, trace to image: the
+//!   furnace against `Le / (1 - rho)` with the predicted k-NN bias, boundary correction on a
+//!   square and a sphere, global-direct and final gathering against the path tracer.
 
 mod cornell;
+mod photon_maps;
 mod photons;
