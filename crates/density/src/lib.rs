@@ -37,6 +37,7 @@ pub mod bench;
 mod estimate;
 mod index;
 mod kernel;
+pub mod splat;
 
 pub use estimate::{EstimateParams, MapPhoton, PhotonMap, radiance_lambertian};
 pub use index::{Brute, Index, IndexKind, KdTree, Kiddo, KnnHint, Neighbor};

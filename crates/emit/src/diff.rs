@@ -49,6 +49,13 @@ pub struct RayDiff {
 
 impl RayDiff {
     /// Area of the positional parallelogram `|∂o/∂u × ∂o/∂v|`.
+    /// All six vectors finite (a degenerate transfer or refraction is not).
+    pub fn is_finite(&self) -> bool {
+        [self.o, self.d, self.dodu, self.dodv, self.dddu, self.dddv]
+            .iter()
+            .all(|v| v.is_finite())
+    }
+
     pub fn footprint_area(&self) -> f32 {
         self.dodu.cross(self.dodv).length()
     }

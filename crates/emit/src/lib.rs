@@ -28,11 +28,13 @@
 //!   `Φ *= f |cos θ| / pdf` (glass: Fresnel-chosen reflection or refraction, weight 1);
 //! - black surfaces absorb; a path ends on escape or after [`EmitParams::max_depth`] hits.
 
+mod caustic;
 pub mod diff;
 mod params;
 mod plan;
 mod trace;
 
+pub use caustic::{CausticPhoton, trace_caustics};
 pub use diff::{RayDiff, emit_diff, mesh_dn, reflect_diff, refract_diff, sphere_dn, transfer};
 pub use params::EmitParams;
 pub use plan::{Plan, PlanError};

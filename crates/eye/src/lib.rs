@@ -25,10 +25,12 @@
 mod path;
 mod photon;
 mod render;
+mod vertices;
 
 pub use path::{Part, PathOptions, PathTracer, Radiance};
 pub use photon::{Irradiance, MapLookup, render_final_gather, render_global_direct};
 pub use render::{RenderOptions, render};
+pub use vertices::{EyeVertex, VertexOptions, eye_vertices};
 
 #[cfg(test)]
 mod tests;

@@ -48,9 +48,14 @@ impl Part {
         }
     }
 
-    /// True for the two layers photon splatting may replace.
+    /// True for both caustic layers.
     pub const fn is_caustic(self) -> bool {
         matches!(self, Part::Caustic | Part::CausticIndirect)
+    }
+
+    /// True for the layer photon splatting replaces (see [`PathOptions::caustics`]).
+    pub const fn is_splatted(self) -> bool {
+        matches!(self, Part::Caustic)
     }
 }
 
@@ -85,8 +90,11 @@ pub struct PathOptions {
     pub max_depth: u32,
     /// Russian roulette applies once this many bounces have been made.
     pub rr_depth: u32,
-    /// When false, `L S+ D ...` paths are left out: both caustic parts stay zero and
-    /// nothing else changes.
+    /// When false, exactly the paths photon splatting owns are left out: `L S+ D S* E` with
+    /// `D` the first non-delta vertex from the eye ([`Part::Caustic`] stays zero). Caustics
+    /// seen after a further diffuse bounce (`L S+ D (S* D)+ S* E`, [`Part::CausticIndirect`])
+    /// stay, since splatting onto first eye vertices cannot reach them; nothing else changes.
+    /// So `path` without caustics plus a splatted caustic layer is the whole image.
     pub caustics: bool,
 }
 
@@ -145,15 +153,12 @@ impl<'a> PathTracer<'a> {
                         let pdf_light = lights.pdf(light, p, hit.point.p);
                         let w = power_heuristic(1, pdf_bsdf, 1, pdf_light);
                         out.add(direct_or_indirect(diffuse_vertices), beta * le * w);
-                    } else if self.opts.caustics {
+                    } else if diffuse_vertices > 1 {
                         // Specular chain from a diffuse vertex to the light: NEE's shadow
                         // rays cannot follow it, so BSDF sampling owns it (weight 1).
-                        let part = if diffuse_vertices == 1 {
-                            Part::Caustic
-                        } else {
-                            Part::CausticIndirect
-                        };
-                        out.add(part, beta * le);
+                        out.add(Part::CausticIndirect, beta * le);
+                    } else if self.opts.caustics {
+                        out.add(Part::Caustic, beta * le);
                     }
                 }
             }

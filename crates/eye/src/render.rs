@@ -11,7 +11,8 @@ use scene::Scene;
 pub struct RenderOptions {
     /// Samples per pixel (box-filtered, jittered within the pixel).
     pub spp: u32,
-    /// Include `L S+ D ...` paths (the two caustic layers); see [`PathOptions::caustics`].
+    /// Include the paths photon splatting owns (`L S+ D S* E`, the `caustic` layer); see
+    /// [`PathOptions::caustics`].
     pub caustics: bool,
     /// Worker threads; `None` uses rayon's global pool. Does not change the image.
     pub threads: Option<usize>,

@@ -136,12 +136,36 @@ pub fn run(
     opts: &PipelineOptions,
     progress: &Progress,
 ) -> Result<TraceStats, String> {
+    run_chunks(
+        params.photons,
+        opts,
+        &|range| emit::trace_range(scene, params, plan, range),
+        &mut |traced: Traced| {
+            let traced = Arc::new(traced);
+            for sink in sinks.iter_mut() {
+                sink.consume(&traced)?;
+            }
+            progress.inc(traced.emitted);
+            Ok(())
+        },
+    )
+}
+
+/// The pipeline's machinery for any per-chunk work: `0..total` in chunks of `opts.chunk`
+/// indices, `work` on `opts.threads` workers, and `consume` on this thread for every result
+/// in index order, with at most `opts.window` results alive at once.
+pub fn run_chunks<T: Send>(
+    total: u64,
+    opts: &PipelineOptions,
+    work: &(dyn Fn(std::ops::Range<u64>) -> T + Sync),
+    consume: &mut dyn FnMut(T) -> Result<(), String>,
+) -> Result<TraceStats, String> {
     let start = std::time::Instant::now();
-    let ranges: Vec<std::ops::Range<u64>> = emit::chunks(params.photons, opts.chunk).collect();
+    let ranges: Vec<std::ops::Range<u64>> = emit::chunks(total, opts.chunk).collect();
     let n = ranges.len();
     let window = opts.window.max(1);
     let (ticket_tx, ticket_rx) = bounded::<usize>(window);
-    let (tx, rx) = bounded::<(usize, Traced)>(window);
+    let (tx, rx) = bounded::<(usize, T)>(window);
     for t in 0..window.min(n) {
         ticket_tx.send(t).expect("receiver alive");
     }
@@ -150,26 +174,22 @@ pub fn run(
         // Owned by this closure, so an early error return drops them and every worker wakes
         // (a blocked `send` fails, the ticket loop ends) before the scope joins.
         let (rx, ticket_tx) = (rx, ticket_tx);
-        for _ in 0..opts.threads {
+        for _ in 0..opts.threads.max(1) {
             let (ticket_rx, tx) = (ticket_rx.clone(), tx.clone());
             let ranges = &ranges;
-            s.spawn(move || worker(scene, params, plan, ranges, ticket_rx, tx));
+            s.spawn(move || worker(work, ranges, ticket_rx, tx));
         }
         drop((ticket_rx, tx));
-        let mut pending: BTreeMap<usize, Traced> = BTreeMap::new();
+        let mut pending: BTreeMap<usize, T> = BTreeMap::new();
         let mut next = 0;
         while next < n {
-            let Ok((i, traced)) = rx.recv() else {
+            let Ok((i, item)) = rx.recv() else {
                 return Err("a photon worker stopped before its work was done".into());
             };
-            pending.insert(i, traced);
+            pending.insert(i, item);
             max_in_flight = max_in_flight.max(pending.len() + rx.len());
-            while let Some(traced) = pending.remove(&next) {
-                let traced = Arc::new(traced);
-                for sink in sinks.iter_mut() {
-                    sink.consume(&traced)?;
-                }
-                progress.inc(traced.emitted);
+            while let Some(item) = pending.remove(&next) {
+                consume(item)?;
                 next += 1;
                 if next + window - 1 < n {
                     // Tickets are never more than `window`: the channel cannot be full.
@@ -182,24 +202,21 @@ pub fn run(
     });
     result?;
     Ok(TraceStats {
-        emitted: params.photons,
+        emitted: total,
         seconds: start.elapsed().as_secs_f64(),
         max_in_flight,
     })
 }
 
-fn worker(
-    scene: &Scene,
-    params: &EmitParams,
-    plan: &Plan,
+fn worker<T: Send>(
+    work: &(dyn Fn(std::ops::Range<u64>) -> T + Sync),
     ranges: &[std::ops::Range<u64>],
     tickets: Receiver<usize>,
-    out: Sender<(usize, Traced)>,
+    out: Sender<(usize, T)>,
 ) {
     for i in tickets {
-        let traced = emit::trace_range(scene, params, plan, ranges[i].clone());
-        if out.send((i, traced)).is_err() {
-            return; // the writer failed and hung up
+        if out.send((i, work(ranges[i].clone()))).is_err() {
+            return; // the consumer failed and hung up
         }
     }
 }

@@ -27,6 +27,7 @@ pub mod output;
 pub mod photon_cache;
 pub mod progress;
 pub mod settings;
+pub mod splat;
 pub mod worksheet;
 
 #[cfg(test)]

@@ -24,6 +24,33 @@ pub struct EstimateSettings {
     /// The caustic map's estimate (course framework: k = 250).
     pub caustic: EstimateParams,
     pub final_gather: FinalGatherSettings,
+    pub splat: SplatSettings,
+}
+
+/// `[estimate.splat]`: photon differential splatting (Frisvad et al. 2014).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SplatSettings {
+    /// The smoothing parameter `s`: every differential at emission is scaled by it (1 tiles
+    /// the lit area about once; larger is smoother).
+    pub scale: f32,
+    /// Caustic photon paths emitted (0: `[photons] photons`).
+    pub photons: u64,
+    /// Largest footprint semi-axis, in scene units (0: 2% of the scene's bounding diagonal).
+    pub max_radius: f32,
+    /// Dielectric hits at which eye paths follow both reflection and refraction.
+    pub splits: u32,
+}
+
+impl Default for SplatSettings {
+    fn default() -> Self {
+        SplatSettings {
+            scale: 1.0,
+            photons: 0,
+            max_radius: 0.0,
+            splits: 2,
+        }
+    }
 }
 
 /// `[estimate.final_gather]`.
@@ -60,6 +87,7 @@ impl Default for EstimateSettings {
                 ..EstimateParams::default()
             },
             final_gather: FinalGatherSettings::default(),
+            splat: SplatSettings::default(),
         }
     }
 }
@@ -222,6 +250,25 @@ impl Settings {
             return Err(format!(
                 "estimate.final_gather.rays = {} is absurd (at most 65536)",
                 e.final_gather.rays
+            ));
+        }
+        let sp = &e.splat;
+        if !(sp.scale > 0.0 && sp.scale <= 1e3) {
+            return Err(format!(
+                "estimate.splat.scale = {} must be in (0, 1000]",
+                sp.scale
+            ));
+        }
+        if !(sp.max_radius >= 0.0 && sp.max_radius.is_finite()) {
+            return Err(format!(
+                "estimate.splat.max_radius = {} must be finite and >= 0",
+                sp.max_radius
+            ));
+        }
+        if sp.photons > 1 << 40 || sp.splits > 16 {
+            return Err(format!(
+                "estimate.splat: photons = {} (at most 2^40) or splits = {} (at most 16) is absurd",
+                sp.photons, sp.splits
             ));
         }
         if e.boundary && e.global.topo.is_none() {

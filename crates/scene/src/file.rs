@@ -85,8 +85,9 @@ pub struct RenderSettings {
     pub tile: u32,
     /// What `render` does without `--method` (see [`Method`]).
     pub method: Method,
-    /// Whether the path tracer follows `L S+ D ...` paths (caustics); off leaves both caustic
-    /// layers out, so a caustic layer made by photons can be composited in their place.
+    /// Whether the path tracer estimates the paths photon splatting owns, `L S+ D S* E` with
+    /// `D` the first diffuse vertex from the eye (the `caustic` layer); off leaves exactly
+    /// those out, so a splatted caustic layer can be composited in their place.
     pub caustics: bool,
 }
 
@@ -104,11 +105,23 @@ pub enum Method {
     /// the global map.
     #[default]
     FinalGather,
+    /// The caustic layer alone, `L S+ D S* E`, by photon differential splatting onto eye
+    /// vertices (no photon map); composite it with any method that leaves it out.
+    CausticSplat,
+    /// The path tracer without the paths splatting owns, plus the splatted caustic layer.
+    #[serde(rename = "path+splat")]
+    PathSplat,
 }
 
 impl Method {
     /// Every method, in declaration order.
-    pub const ALL: [Method; 3] = [Method::Path, Method::GlobalDirect, Method::FinalGather];
+    pub const ALL: [Method; 5] = [
+        Method::Path,
+        Method::GlobalDirect,
+        Method::FinalGather,
+        Method::CausticSplat,
+        Method::PathSplat,
+    ];
 
     /// The method's name as the scene file spells it.
     pub fn name(self) -> String {

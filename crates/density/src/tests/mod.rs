@@ -33,6 +33,7 @@ macro_rules! each_index {
 mod estimate;
 mod kernel;
 mod knn;
+mod splat;
 
 /// Mean and standard error of independent samples.
 fn mean_se(xs: &[f64]) -> (f64, f64) {

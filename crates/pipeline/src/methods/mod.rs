@@ -4,9 +4,11 @@
 //! the light-path classes it estimates so that layers of separate runs can be composited
 //! without counting a path twice.
 
+mod caustic_splat;
 mod final_gather;
 mod global_direct;
 mod path;
+mod path_splat;
 
 use crate::maps::Maps;
 use crate::photon_cache::{self, CacheKey};
@@ -116,6 +118,8 @@ pub fn spec(method: Method) -> MethodSpec {
         Method::Path => (path::render, false),
         Method::GlobalDirect => (global_direct::render, true),
         Method::FinalGather => (final_gather::render, true),
+        Method::CausticSplat => (caustic_splat::render, false),
+        Method::PathSplat => (path_splat::render, false),
     };
     MethodSpec {
         render,

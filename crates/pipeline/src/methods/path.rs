@@ -13,11 +13,11 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     let t0 = std::time::Instant::now();
     let film = eye::render(run.scene, &opts, progress);
     let seconds = t0.elapsed().as_secs_f64();
-    // Each path-traced layer is one class; with caustics off the caustic layers estimate
-    // nothing and are left out, so a caustic image made elsewhere can take their place.
+    // Each path-traced layer is one class; with caustics off the `caustic` layer estimates
+    // nothing and is left out, so a splatted caustic layer can take its place.
     let parts: Vec<Part> = Part::ALL
         .into_iter()
-        .filter(|p| r.caustics || !p.is_caustic())
+        .filter(|p| r.caustics || !p.is_splatted())
         .collect();
     let specs: Vec<LayerSpec> = parts
         .iter()

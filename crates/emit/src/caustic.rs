@@ -1,0 +1,152 @@
+//! Caustic photons with differentials (Schjøth et al. 2007, "Photon differentials"; Frisvad
+//! et al. 2014, "Photon differential splatting for rendering caustics"): each path starts
+//! from [`emit_diff`] at an area light and carries its differentials (Igehy 1999) through
+//! mirror, metal and glass to its first diffuse hit after at least one specular bounce
+//! (L S+ D), where the transferred positional derivatives are the two axes of the photon's
+//! footprint. Paths whose first hit is diffuse (direct light) carry no caustic and end there.
+//!
+//! Photon `i` draws the same random numbers as [`crate::trace_range`]'s photon `i` (5 to
+//! emit, 3 per hit), so a splatted caustic photon and the caustic map's photon of the same
+//! index follow the same path and carry the same flux.
+
+use crate::diff::{emit_diff, mesh_dn, reflect_diff, refract_diff, sphere_dn, transfer};
+use crate::{EMIT_STREAM, EmitParams};
+use bsdf::{Bsdf, TransportMode};
+use geom::{Hit, Prim};
+use glam::Vec3;
+use math::{Frame, Rng};
+use scene::{Scene, sides_agree, surface_id};
+use std::ops::Range;
+
+/// A caustic photon at its first diffuse hit, with its footprint.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CausticPhoton {
+    pub position: Vec3,
+    /// Unit geometric normal of the surface, on the side the photon arrived from.
+    pub normal: Vec3,
+    /// [`scene::surface_id`] of the primitive hit.
+    pub surface: u32,
+    /// Flux, already divided by the number of paths emitted.
+    pub flux: Vec3,
+    /// Footprint semi-axes in the tangent plane: the positional derivatives after the last
+    /// transfer (`∂x/∂u`, `∂x/∂v`, scaled by the smoothing parameter at emission).
+    pub a: Vec3,
+    pub b: Vec3,
+}
+
+/// The caustic photons of paths `range` (indices into `0..params.photons`), in index order;
+/// `scale` is the smoothing parameter `s` of [`emit_diff`]. A pure function of the scene's
+/// seed and the indices, like [`crate::trace_range`].
+pub fn trace_caustics(
+    scene: &Scene,
+    params: &EmitParams,
+    scale: f32,
+    range: Range<u64>,
+) -> Vec<CausticPhoton> {
+    let mut out = Vec::new();
+    if params.max_depth == 0 {
+        return out;
+    }
+    for i in range {
+        if let Some(p) = trace_one(scene, params, scale, i) {
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// Derivatives of the shading normal at `hit` for the positional derivatives `dx`, `dy`
+/// (already transferred to the surface): the curvature that focuses a caustic.
+fn normal_derivatives(scene: &Scene, hit: &Hit, dx: Vec3, dy: Vec3) -> (Vec3, Vec3) {
+    match hit.prim {
+        Prim::Sphere(s) => {
+            let r = scene.geometry.spheres()[s as usize].radius;
+            (sphere_dn(dx, r), sphere_dn(dy, r))
+        }
+        Prim::Triangle(t) => {
+            let mesh = scene.geometry.mesh();
+            if mesh.normals.is_empty() {
+                return (Vec3::ZERO, Vec3::ZERO); // flat facets: no curvature
+            }
+            let idx = mesh.indices[t as usize];
+            let ns = idx.map(|i| mesh.normals[i as usize]);
+            let p = mesh.vertices(t as usize);
+            let [b1, b2] = hit.uv;
+            let b = [1.0 - b1 - b2, b1, b2];
+            (mesh_dn(dx, p, ns, b), mesh_dn(dy, p, ns, b))
+        }
+    }
+}
+
+fn trace_one(scene: &Scene, params: &EmitParams, scale: f32, index: u64) -> Option<CausticPhoton> {
+    let mut rng = Rng::for_index(scene.seed() ^ EMIT_STREAM, index);
+    // The layout of `trace_range`: 5 numbers to emit, then 3 per hit, used or not.
+    let (u_light, u_pos, u_dir) = (rng.uniform(), rng.uniform2(), rng.uniform2());
+    let (e, mut rd) = emit_diff(
+        &scene.light_table,
+        u_light,
+        u_pos,
+        u_dir,
+        params.photons,
+        scale,
+    );
+    let mut flux = e.flux.as_vec3();
+    let mut ray = e.ray;
+    // Every hit before the diffuse one is specular, so the hit index counts them.
+    for specular_bounces in 0..params.max_depth {
+        if !flux.cmpgt(Vec3::ZERO).any() {
+            return None;
+        }
+        let hit = scene.geometry.intersect(&ray)?;
+        let (uc, u) = (rng.uniform(), rng.uniform2());
+        let bsdf = scene.bsdf(hit.material)?;
+        let d = ray.d.normalize();
+        let ng = hit.point.n;
+        // Move the differentials onto the surface's plane: the footprint on this surface.
+        rd.o = ray.o;
+        rd.d = d;
+        rd = transfer(&rd, hit.t, ng);
+        if !rd.is_finite() {
+            return None;
+        }
+        if !bsdf.is_delta() {
+            // First diffuse hit: a caustic photon if the path so far is L S+.
+            return (specular_bounces > 0).then(|| CausticPhoton {
+                position: hit.point.p,
+                normal: if d.dot(ng) < 0.0 { ng } else { -ng },
+                surface: surface_id(hit.prim),
+                flux,
+                a: rd.dodu,
+                b: rd.dodv,
+            });
+        }
+        let wo = -d;
+        let frame = Frame::from_z(hit.ns);
+        let wo_local = frame.to_local(wo);
+        if wo_local.z * wo.dot(ng) <= 0.0 {
+            return None;
+        }
+        let s = bsdf.sample(wo_local, uc, u, TransportMode::Importance)?;
+        let wi = frame.to_world(s.wi).normalize();
+        if !sides_agree(wo, wi, ng, wo_local, s.wi) {
+            return None;
+        }
+        flux *= s.weight();
+        let (dndu, dndv) = normal_derivatives(scene, &hit, rd.dodu, rd.dodv);
+        let n = hit.ns;
+        rd = match (s.is_transmission(), bsdf) {
+            (true, Bsdf::Dielectric(g)) => {
+                // Entering when the photon arrives on the shading normal's side (the
+                // dielectric's own convention).
+                let eta = if d.dot(n) < 0.0 { 1.0 / g.eta } else { g.eta };
+                refract_diff(&rd, n, dndu, dndv, eta)
+                    .unwrap_or_else(|| reflect_diff(&rd, n, dndu, dndv))
+            }
+            _ => reflect_diff(&rd, n, dndu, dndv),
+        };
+        ray = hit.point.spawn_ray(wi);
+        // The sampled direction is the one traced; the differentials follow it.
+        rd.d = wi;
+    }
+    None
+}

@@ -1,0 +1,21 @@
+//! `path+splat`: the path tracer without the paths splatting owns (`render.caustics` off:
+//! exactly `L S+ D S* E` with D the first diffuse vertex from the eye), plus those paths by
+//! photon differential splatting. The layers partition path space (`eye::Part`), so nothing
+//! is counted twice and nothing is missed; they are composited as `composite` would.
+
+use super::{Rendered, Run};
+
+pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
+    let mut settings = run.settings.clone();
+    settings.render.caustics = false;
+    let path_run = Run {
+        settings: &settings,
+        ..*run
+    };
+    let mut r = super::path::render(&path_run, progress)?;
+    // The splat's progress counts photons, not samples: it reports through its own line.
+    let (caustic, info) = super::caustic_splat::caustic_layer(run, &|_| {})?;
+    r.layers.push(caustic);
+    r.info.extend(info);
+    Ok(r)
+}

@@ -1,0 +1,171 @@
+//! Photon differential splatting onto eye vertices (Frisvad et al. 2014): the eye vertices
+//! (E S* D) are indexed once; caustic photons with differentials (L S+ D, `emit`) are traced
+//! in chunks on the pipeline's workers, and each photon adds to every eye vertex inside its
+//! footprint `Φ_p K(|M (y - x_p)|) |det M|` (`density::splat`), accepting only vertices on
+//! the same surface and side. No photon is stored in a map or a file: a chunk's photons live
+//! only while its worker splats them, and what crosses the channel to the ordering stage is
+//! the chunk's pixel contributions, added in chunk order (so the image is the same for any
+//! thread count).
+
+use crate::flow::{self, PipelineOptions, TraceStats};
+use crate::settings::SplatSettings;
+use density::splat::Footprint;
+use density::{Index, IndexKind, Neighbor};
+use emit::{CausticPhoton, EmitParams};
+use eye::EyeVertex;
+use glam::{DVec3, Vec3};
+use scene::Scene;
+
+/// How far off the photon's tangent plane a vertex may lie, relative to its distance: the
+/// topological test of the k-NN estimates (keeps a splat on its own surface).
+const TOPO_EPS: f32 = 0.1;
+/// Smallest cosine between a vertex's normal and the photon's: same surface, same side.
+const SAME_SIDE_COS: f32 = 0.9;
+
+/// Eye vertices under a kd-tree.
+pub struct EyeIndex {
+    index: Index,
+    vertices: Vec<EyeVertex>,
+}
+
+impl EyeIndex {
+    pub fn new(vertices: Vec<EyeVertex>) -> EyeIndex {
+        let points: Vec<[f32; 3]> = vertices.iter().map(|v| v.p.to_array()).collect();
+        EyeIndex {
+            index: Index::build(IndexKind::KdTree, &points),
+            vertices,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.vertices.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.vertices.is_empty()
+    }
+
+    pub fn vertices(&self) -> &[EyeVertex] {
+        &self.vertices
+    }
+}
+
+/// Scratch space of one worker.
+#[derive(Default)]
+pub struct Scratch {
+    near: Vec<Neighbor>,
+}
+
+/// The footprint of `p`: its differentials, each principal semi-axis no thinner than the
+/// spacing of the eye vertices nearest to it (else the splat falls between them) and no
+/// wider than `max_radius`.
+pub fn footprint(
+    eyes: &EyeIndex,
+    p: &CausticPhoton,
+    max_radius: f32,
+    scratch: &mut Scratch,
+) -> Option<Footprint> {
+    eyes.index
+        .knn(p.position, 1, f32::INFINITY, &mut scratch.near);
+    let spacing = scratch
+        .near
+        .first()
+        .map_or(max_radius, |nb| eyes.vertices[nb.index as usize].spacing);
+    let min_len = spacing.clamp(max_radius * 1e-6, max_radius);
+    Footprint::new(p.position, p.normal, p.a, p.b, min_len, max_radius)
+}
+
+/// Adds what `photons` deposit at the eye vertices to `out`, as `(pixel, radiance)` pairs
+/// in photon order, then vertex order.
+pub fn splat(
+    eyes: &EyeIndex,
+    photons: &[CausticPhoton],
+    max_radius: f32,
+    scratch: &mut Scratch,
+    out: &mut Vec<(u32, DVec3)>,
+) {
+    for p in photons {
+        if !p.flux.is_finite() {
+            continue;
+        }
+        let Some(f) = footprint(eyes, p, max_radius, scratch) else {
+            continue;
+        };
+        eyes.index.within(p.position, f.radius(), &mut scratch.near);
+        for nb in &scratch.near {
+            let v = &eyes.vertices[nb.index as usize];
+            let d = v.p - p.position;
+            if v.ng.dot(f.normal) < SAME_SIDE_COS
+                || d.dot(f.normal).abs() > TOPO_EPS * d.length() + 1e-4 * f.axes[1]
+            {
+                continue;
+            }
+            let w = f.weight(v.p);
+            if w > 0.0 {
+                let e = p.flux.as_dvec3() * w;
+                out.push((v.pixel, v.weight.as_dvec3() * e));
+            }
+        }
+    }
+}
+
+/// The largest footprint semi-axis: the setting, or 2% of the scene's bounding diagonal.
+pub fn max_radius(scene: &Scene, s: &SplatSettings) -> f32 {
+    if s.max_radius > 0.0 {
+        return s.max_radius;
+    }
+    let b = scene.geometry.bounds();
+    let diag = (b.max - b.min).length();
+    if diag.is_finite() && diag > 0.0 {
+        0.02 * diag
+    } else {
+        1.0
+    }
+}
+
+/// The caustic layer: `photons` caustic paths (`params` for depth; `s` for the smoothing
+/// parameter and the largest footprint) splatted onto `eyes`, one f64 RGB sum per pixel.
+pub fn splat_caustics(
+    scene: &Scene,
+    params: &EmitParams,
+    s: &SplatSettings,
+    eyes: &EyeIndex,
+    threads: usize,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<(Vec<DVec3>, TraceStats), String> {
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    let mut image = vec![DVec3::ZERO; w * h];
+    let max_r = max_radius(scene, s);
+    let work = |range: std::ops::Range<u64>| -> (u64, Vec<(u32, DVec3)>) {
+        let n = range.end - range.start;
+        let photons = emit::trace_caustics(scene, params, s.scale, range);
+        let mut out = Vec::new();
+        let mut scratch = Scratch::default();
+        splat(eyes, &photons, max_r, &mut scratch, &mut out);
+        (n, out)
+    };
+    let stats = flow::run_chunks(
+        params.photons,
+        &PipelineOptions::new(threads),
+        &work,
+        &mut |(n, contributions): (u64, Vec<(u32, DVec3)>)| {
+            for (pixel, v) in contributions {
+                if v.is_finite() {
+                    image[pixel as usize] += v;
+                }
+            }
+            progress(n);
+            Ok(())
+        },
+    )?;
+    Ok((image, stats))
+}
+
+/// Pixels of an f64 sum as an f32 image.
+pub fn to_image(scene: &Scene, pixels: &[DVec3]) -> film::Image {
+    let w = scene.camera.width as usize;
+    film::Image::from_fn(w, scene.camera.height as usize, |x, y| {
+        let v: Vec3 = pixels[y * w + x].as_vec3();
+        v.to_array()
+    })
+}
