@@ -657,3 +657,25 @@ fn photons_record_their_surface_and_direction_of_travel() {
         Material::Dielectric { .. }
     ));
 }
+
+#[test]
+fn splatted_caustic_photons_are_the_caustic_maps_photons_with_footprints() {
+    // Same streams, same rules: photon i of `trace_caustics` is photon i of the caustic set,
+    // at the same point with the same flux; its footprint lies in the surface's plane.
+    let scene = load("cornell-spheres/analytic.toml");
+    let p = params(20_000);
+    let t = trace_range(&scene, &p, &plan(&scene, &p), 0..p.photons);
+    let c = crate::trace_caustics(&scene, &p, 1.0, 0..p.photons);
+    let map = &t[MapKind::Caustic];
+    assert!(map.len() > 100, "{} caustic photons", map.len());
+    assert_eq!(c.len(), map.len());
+    for (s, m) in c.iter().zip(map) {
+        assert_eq!(s.position, m.position());
+        assert_eq!(s.flux, m.power());
+        assert!((s.normal.dot(m.direction()) + s.normal.dot(m.direction()).abs()) < 1e-6);
+        for axis in [s.a, s.b] {
+            assert!(axis.is_finite() && axis.length() > 0.0, "{axis}");
+            assert!(axis.dot(s.normal).abs() <= 1e-3 * axis.length(), "{axis} {}", s.normal);
+        }
+    }
+}
