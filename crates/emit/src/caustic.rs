@@ -34,25 +34,42 @@ pub struct CausticPhoton {
     pub b: Vec3,
 }
 
-/// The caustic photons of paths `range` (indices into `0..params.photons`), in index order;
-/// `scale` is the smoothing parameter `s` of [`emit_diff`]. A pure function of the scene's
-/// seed and the indices, like [`crate::trace_range`].
+/// The caustic photons of paths `range` (indices into `0..params.photons`) of pass `pass`,
+/// in index order; `scale` is the smoothing parameter `s` of [`emit_diff`]. Photon `i` of
+/// pass `j` draws from the stream `(seed, j, i)` alone ([`pass_stream`]), so the result is a
+/// pure function of the scene's seed, the pass and the indices, like [`crate::trace_range`].
 pub fn trace_caustics(
     scene: &Scene,
     params: &EmitParams,
     scale: f32,
+    pass: u64,
     range: Range<u64>,
 ) -> Vec<CausticPhoton> {
     let mut out = Vec::new();
     if params.max_depth == 0 {
         return out;
     }
+    let stream = pass_stream(scene.seed(), pass);
     for i in range {
-        if let Some(p) = trace_one(scene, params, scale, i) {
+        if let Some(p) = trace_one(scene, params, scale, stream, i) {
             out.push(p);
         }
     }
     out
+}
+
+/// The seed of pass `pass`'s photon streams: pass 0 is the photon tracer's own
+/// (`seed ^ EMIT_STREAM`, so its photons are the caustic map's), later passes are mixed
+/// apart by a splitmix64 step (Steele et al. 2014) of the pass number.
+pub fn pass_stream(seed: u64, pass: u64) -> u64 {
+    let base = seed ^ EMIT_STREAM;
+    if pass == 0 {
+        return base;
+    }
+    let mut z = pass.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    base ^ z ^ (z >> 31)
 }
 
 /// Derivatives of the shading normal at `hit` for the positional derivatives `dx`, `dy`
@@ -78,8 +95,14 @@ fn normal_derivatives(scene: &Scene, hit: &Hit, dx: Vec3, dy: Vec3) -> (Vec3, Ve
     }
 }
 
-fn trace_one(scene: &Scene, params: &EmitParams, scale: f32, index: u64) -> Option<CausticPhoton> {
-    let mut rng = Rng::for_index(scene.seed() ^ EMIT_STREAM, index);
+fn trace_one(
+    scene: &Scene,
+    params: &EmitParams,
+    scale: f32,
+    stream: u64,
+    index: u64,
+) -> Option<CausticPhoton> {
+    let mut rng = Rng::for_index(stream, index);
     // The layout of `trace_range`: 5 numbers to emit, then 3 per hit, used or not.
     let (u_light, u_pos, u_dir) = (rng.uniform(), rng.uniform2(), rng.uniform2());
     let (e, mut rd) = emit_diff(

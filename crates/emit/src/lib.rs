@@ -34,7 +34,7 @@ mod params;
 mod plan;
 mod trace;
 
-pub use caustic::{CausticPhoton, trace_caustics};
+pub use caustic::{CausticPhoton, pass_stream, trace_caustics};
 pub use diff::{RayDiff, emit_diff, mesh_dn, reflect_diff, refract_diff, sphere_dn, transfer};
 pub use params::EmitParams;
 pub use plan::{Plan, PlanError};

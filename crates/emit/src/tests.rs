@@ -665,7 +665,7 @@ fn splatted_caustic_photons_are_the_caustic_maps_photons_with_footprints() {
     let scene = load("cornell-spheres/analytic.toml");
     let p = params(20_000);
     let t = trace_range(&scene, &p, &plan(&scene, &p), 0..p.photons);
-    let c = crate::trace_caustics(&scene, &p, 1.0, 0..p.photons);
+    let c = crate::trace_caustics(&scene, &p, 1.0, 0, 0..p.photons);
     let map = &t[MapKind::Caustic];
     assert!(map.len() > 100, "{} caustic photons", map.len());
     assert_eq!(c.len(), map.len());
@@ -675,7 +675,21 @@ fn splatted_caustic_photons_are_the_caustic_maps_photons_with_footprints() {
         assert!((s.normal.dot(m.direction()) + s.normal.dot(m.direction()).abs()) < 1e-6);
         for axis in [s.a, s.b] {
             assert!(axis.is_finite() && axis.length() > 0.0, "{axis}");
-            assert!(axis.dot(s.normal).abs() <= 1e-3 * axis.length(), "{axis} {}", s.normal);
+            assert!(
+                axis.dot(s.normal).abs() <= 1e-3 * axis.length(),
+                "{axis} {}",
+                s.normal
+            );
         }
     }
+    // Another pass draws other photons; a range of a pass is that pass's photons.
+    let next = crate::trace_caustics(&scene, &p, 1.0, 1, 0..p.photons);
+    assert!(next.len() > 100 && next[..10] != c[..10]);
+    assert_eq!(
+        crate::trace_caustics(&scene, &p, 1.0, 1, 5_000..p.photons),
+        next.iter()
+            .copied()
+            .filter(|x| !crate::trace_caustics(&scene, &p, 1.0, 1, 0..5_000).contains(x))
+            .collect::<Vec<_>>()
+    );
 }

@@ -298,7 +298,8 @@ fn caustic_switch_removes_exactly_the_caustic_layers() {
             part.name()
         );
     }
-    for part in [Part::Caustic] {
+    {
+        let part = Part::Caustic;
         let l = without.layer(part.name()).unwrap();
         assert!(
             layer(&without, part, spp)

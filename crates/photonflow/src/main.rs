@@ -61,15 +61,16 @@ enum Cmd {
     /// `final-gather` chain trace (or reuse the cached photons) → estimate → composite.
     Render {
         scene: PathBuf,
-        /// path, global-direct or final-gather (default: the scene's render.method, whose
-        /// default is final-gather).
+        /// path, global-direct, final-gather, caustic-splat or path+splat (default: the
+        /// scene's render.method, whose default is final-gather).
         #[arg(long)]
         method: Option<Method>,
         #[command(flatten)]
         photon: PhotonArgs,
         #[command(flatten)]
         image: ImageArgs,
-        /// Leave out L S+ D paths (caustics) so a caustic layer made elsewhere can be added.
+        /// Path tracer: leave out exactly the paths photon splatting owns (L S+ D S* E, D the
+        /// first diffuse vertex from the eye), so a splatted caustic layer can be added.
         #[arg(long)]
         no_caustics: bool,
     },
@@ -204,6 +205,14 @@ struct PhotonArgs {
     /// scene's estimate.final_gather.cache, 4).
     #[arg(long)]
     gather_cache: Option<usize>,
+    /// Photon passes of the progressive methods (caustic-splat, path+splat; default: the
+    /// scene's estimate.splat.passes, 1).
+    #[arg(long)]
+    passes: Option<u32>,
+    /// Stop the progressive methods' passes after this many seconds (at least one pass runs);
+    /// the output's scene.toml records the passes made.
+    #[arg(long)]
+    time: Option<f64>,
     /// Compare with this linear EXR (the path-traced reference) and record the error.
     #[arg(long)]
     reference: Option<PathBuf>,
@@ -226,6 +235,8 @@ impl PhotonArgs {
             gather_rays: self.gather_rays,
             gather_cache: self.gather_cache,
             caustics: None,
+            passes: self.passes,
+            time: self.time,
         }
     }
 }

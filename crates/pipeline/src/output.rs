@@ -58,6 +58,12 @@ pub fn write(
         ),
         None => None,
     };
+    // A run stopped by a time budget is reproduced by the passes it made.
+    let mut settings = settings.clone();
+    if let Some(p) = r.passes {
+        settings.estimate.splat.passes = p;
+    }
+    let settings = &settings;
     let resolved = settings.resolved_scene(scene)?;
     let scene_text = toml::to_string(&resolved).map_err(|e| {
         format!(

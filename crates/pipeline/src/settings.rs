@@ -40,6 +40,9 @@ pub struct SplatSettings {
     pub max_radius: f32,
     /// Dielectric hits at which eye paths follow both reflection and refraction.
     pub splits: u32,
+    /// Photon passes: pass `j` traces `photons` new paths from streams `(seed, j, i)`; the
+    /// layer is their mean. A run stopped by a time budget records the passes it made.
+    pub passes: u32,
 }
 
 impl Default for SplatSettings {
@@ -49,6 +52,7 @@ impl Default for SplatSettings {
             photons: 0,
             max_radius: 0.0,
             splits: 2,
+            passes: 1,
         }
     }
 }
@@ -110,12 +114,19 @@ pub struct Overrides {
     pub gather_cache: Option<usize>,
     /// Whether the path tracer follows caustic paths (`render.caustics`).
     pub caustics: Option<bool>,
+    /// Photon passes of the progressive methods (`[estimate.splat] passes`).
+    pub passes: Option<u32>,
+    /// Stop the progressive methods' passes once this many seconds have passed (after at
+    /// least one); not a setting of the scene file, which records the passes made instead.
+    pub time: Option<f64>,
 }
 
 /// Everything a run needs besides the scene's geometry.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
     pub method: Method,
+    /// Time budget of the progressive passes (see [`Overrides::time`]).
+    pub time: Option<f64>,
     /// `[render]`, with `spp` and `caustics` overridden for the path tracer.
     pub render: scene::RenderSettings,
     pub emit: EmitParams,
@@ -176,8 +187,17 @@ impl Settings {
         if let Some(c) = o.gather_cache {
             estimate.final_gather.cache = c;
         }
+        if let Some(p) = o.passes {
+            estimate.splat.passes = p;
+        }
+        if let Some(t) = o.time
+            && !(t > 0.0 && t.is_finite())
+        {
+            return Err(format!("--time {t} must be a positive number of seconds"));
+        }
         let s = Settings {
             method,
+            time: o.time,
             render,
             emit,
             estimate,
@@ -263,6 +283,12 @@ impl Settings {
             return Err(format!(
                 "estimate.splat.max_radius = {} must be finite and >= 0",
                 sp.max_radius
+            ));
+        }
+        if sp.passes == 0 || sp.passes > 1 << 20 {
+            return Err(format!(
+                "estimate.splat.passes = {} must be in 1..=1048576",
+                sp.passes
             ));
         }
         if sp.photons > 1 << 40 || sp.splits > 16 {

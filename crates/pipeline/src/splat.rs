@@ -123,42 +123,50 @@ pub fn max_radius(scene: &Scene, s: &SplatSettings) -> f32 {
     }
 }
 
-/// The caustic layer: `photons` caustic paths (`params` for depth; `s` for the smoothing
-/// parameter and the largest footprint) splatted onto `eyes`, one f64 RGB sum per pixel.
-pub fn splat_caustics(
-    scene: &Scene,
-    params: &EmitParams,
-    s: &SplatSettings,
-    eyes: &EyeIndex,
-    threads: usize,
-    progress: &(dyn Fn(u64) + Sync),
-) -> Result<(Vec<DVec3>, TraceStats), String> {
-    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-    let mut image = vec![DVec3::ZERO; w * h];
-    let max_r = max_radius(scene, s);
-    let work = |range: std::ops::Range<u64>| -> (u64, Vec<(u32, DVec3)>) {
-        let n = range.end - range.start;
-        let photons = emit::trace_caustics(scene, params, s.scale, range);
-        let mut out = Vec::new();
-        let mut scratch = Scratch::default();
-        splat(eyes, &photons, max_r, &mut scratch, &mut out);
-        (n, out)
-    };
-    let stats = flow::run_chunks(
-        params.photons,
-        &PipelineOptions::new(threads),
-        &work,
-        &mut |(n, contributions): (u64, Vec<(u32, DVec3)>)| {
-            for (pixel, v) in contributions {
-                if v.is_finite() {
-                    image[pixel as usize] += v;
+/// What a splatting pass needs: the scene, its caustic paths' parameters (`params.photons`
+/// per pass, `params.max_depth`), the splat settings and the indexed eye vertices.
+pub struct Splatter<'a> {
+    pub scene: &'a Scene,
+    pub params: &'a EmitParams,
+    pub settings: &'a SplatSettings,
+    pub eyes: &'a EyeIndex,
+}
+
+impl Splatter<'_> {
+    /// One pass of the caustic layer: the caustic paths of pass `pass` splatted onto the eye
+    /// vertices and added to `image` (one f64 RGB sum per pixel) in chunk order.
+    pub fn pass(
+        &self,
+        pass: u64,
+        image: &mut [DVec3],
+        threads: usize,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<TraceStats, String> {
+        let (scene, params, s, eyes) = (self.scene, self.params, self.settings, self.eyes);
+        let max_r = max_radius(scene, s);
+        let work = |range: std::ops::Range<u64>| -> (u64, Vec<(u32, DVec3)>) {
+            let n = range.end - range.start;
+            let photons = emit::trace_caustics(scene, params, s.scale, pass, range);
+            let mut out = Vec::new();
+            let mut scratch = Scratch::default();
+            splat(eyes, &photons, max_r, &mut scratch, &mut out);
+            (n, out)
+        };
+        flow::run_chunks(
+            params.photons,
+            &PipelineOptions::new(threads),
+            &work,
+            &mut |(n, contributions): (u64, Vec<(u32, DVec3)>)| {
+                for (pixel, v) in contributions {
+                    if v.is_finite() {
+                        image[pixel as usize] += v;
+                    }
                 }
-            }
-            progress(n);
-            Ok(())
-        },
-    )?;
-    Ok((image, stats))
+                progress(n);
+                Ok(())
+            },
+        )
+    }
 }
 
 /// Pixels of an f64 sum as an f32 image.

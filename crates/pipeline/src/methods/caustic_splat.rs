@@ -9,7 +9,7 @@ use crate::splat::{self, EyeIndex};
 pub(super) fn caustic_layer(
     run: &Run,
     progress: &(dyn Fn(u64) + Sync),
-) -> Result<(Layer, serde_json::Map<String, serde_json::Value>), String> {
+) -> Result<(Layer, serde_json::Map<String, serde_json::Value>, u32), String> {
     let s = run.settings;
     let sp = &s.estimate.splat;
     let mut params = s.emit.clone();
@@ -27,19 +27,55 @@ pub(super) fn caustic_layer(
     );
     let eyes = EyeIndex::new(vertices);
     let t_vertices = t0.elapsed().as_secs_f64();
-    let (pixels, stats) =
-        splat::splat_caustics(run.scene, &params, sp, &eyes, run.threads(), progress)?;
+    let (w, h) = (
+        run.scene.camera.width as usize,
+        run.scene.camera.height as usize,
+    );
+    let mut pixels = vec![glam::DVec3::ZERO; w * h];
+    // Passes until the count, or the time budget once a pass has been made.
+    let t_splat = std::time::Instant::now();
+    let mut passes = 0u32;
+    let mut max_in_flight = 0;
+    let splatter = splat::Splatter {
+        scene: run.scene,
+        params: &params,
+        settings: sp,
+        eyes: &eyes,
+    };
+    while passes < sp.passes {
+        let stats = splatter.pass(passes as u64, &mut pixels, run.threads(), progress)?;
+        max_in_flight = max_in_flight.max(stats.max_in_flight);
+        passes += 1;
+        let elapsed = t_splat.elapsed().as_secs_f64();
+        if sp.passes > 1 {
+            eprintln!(
+                "splat pass {passes}/{}: {:.2} s, {:.3} M photons/s",
+                sp.passes,
+                elapsed,
+                (passes as u64 * params.photons) as f64 / elapsed / 1e6
+            );
+        }
+        if s.time.is_some_and(|t| elapsed >= t) {
+            break;
+        }
+    }
+    let seconds = t_splat.elapsed().as_secs_f64();
+    for p in &mut pixels {
+        *p /= passes as f64;
+    }
     let mut info = serde_json::Map::new();
     for (k, v) in [
         ("splat", serde_json::json!(sp)),
         ("splat_photons_emitted", params.photons.into()),
         ("eye_vertices", eyes.len().into()),
         ("splat_max_radius", splat::max_radius(run.scene, sp).into()),
+        ("splat_passes", passes.into()),
+        ("splat_max_chunks_in_flight", max_in_flight.into()),
         ("time_eye_vertices_s", t_vertices.into()),
-        ("time_splat_s", stats.seconds.into()),
+        ("time_splat_s", seconds.into()),
         (
             "splat_photons_per_s",
-            (params.photons as f64 / stats.seconds).into(),
+            ((passes as u64 * params.photons) as f64 / seconds).into(),
         ),
     ] {
         info.insert(k.to_string(), v);
@@ -48,17 +84,18 @@ pub(super) fn caustic_layer(
         name: "caustic".into(),
         classes: vec!["caustic"],
         image: splat::to_image(run.scene, &pixels),
-        count: params.photons,
+        count: passes as u64 * params.photons,
         count_kind: CountKind::PhotonPaths,
     };
-    Ok((layer, info))
+    Ok((layer, info, passes))
 }
 
 pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
-    let (layer, info) = caustic_layer(run, progress)?;
+    let (layer, info, passes) = caustic_layer(run, progress)?;
     Ok(Rendered {
         layers: vec![layer],
         plan: None,
         info,
+        passes: Some(passes),
     })
 }

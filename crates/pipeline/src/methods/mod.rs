@@ -83,6 +83,8 @@ pub struct Rendered {
     pub plan: Option<Plan>,
     /// Method-specific facts for `image.json` (settings used, photon counts, timings).
     pub info: serde_json::Map<String, serde_json::Value>,
+    /// Photon passes made, for progressive methods (the resolved scene records them).
+    pub passes: Option<u32>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -108,22 +110,25 @@ pub struct MethodSpec {
     /// It reads photon maps: `estimate` may run it from cached photon sets, and its samples
     /// per pixel are `[estimate] spp` (else `[render] spp`).
     pub photon_maps: bool,
+    /// Its progress counts splatted photons (else pixel samples).
+    pub splat_progress: bool,
 }
 
 type RenderFn = fn(&Run, &(dyn Fn(u64) + Sync)) -> Result<Rendered, String>;
 
 /// The one `match` on `scene::Method`.
 pub fn spec(method: Method) -> MethodSpec {
-    let (render, photon_maps): (RenderFn, bool) = match method {
-        Method::Path => (path::render, false),
-        Method::GlobalDirect => (global_direct::render, true),
-        Method::FinalGather => (final_gather::render, true),
-        Method::CausticSplat => (caustic_splat::render, false),
-        Method::PathSplat => (path_splat::render, false),
+    let (render, photon_maps, splat_progress): (RenderFn, bool, bool) = match method {
+        Method::Path => (path::render, false, false),
+        Method::GlobalDirect => (global_direct::render, true, false),
+        Method::FinalGather => (final_gather::render, true, false),
+        Method::CausticSplat => (caustic_splat::render, false, true),
+        Method::PathSplat => (path_splat::render, false, false),
     };
     MethodSpec {
         render,
         photon_maps,
+        splat_progress,
     }
 }
 

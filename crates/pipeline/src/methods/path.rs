@@ -52,5 +52,6 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
         layers,
         plan: None,
         info,
+        passes: None,
     })
 }

@@ -14,8 +14,9 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     };
     let mut r = super::path::render(&path_run, progress)?;
     // The splat's progress counts photons, not samples: it reports through its own line.
-    let (caustic, info) = super::caustic_splat::caustic_layer(run, &|_| {})?;
+    let (caustic, info, passes) = super::caustic_splat::caustic_layer(run, &|_| {})?;
     r.layers.push(caustic);
     r.info.extend(info);
+    r.passes = Some(passes);
     Ok(r)
 }
