@@ -37,6 +37,9 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
                       photon paths/s on 1 and 2 threads (tracing alone and into photon files)
   bench store [--photons N]
                       write/read GB/s of a 10M-photon file; plain records against bincode
+  bench splat [SCENE] [--photons N] [--runs N]
+                      caustic photons splatted per second on 1 and 2 threads, eye vertices,
+                      peak memory (default scene: scenes/cornell-spheres/analytic.toml)
   bench knn [--photons N] [--queries N]
                       k-NN queries/s for k = 50, 250, 1000 per index (kd-tree, kiddo, brute),
                       and pixel-order irradiance queries with radius hints
@@ -64,6 +67,7 @@ pub struct Bench {
 }
 
 pub const DEFAULT_SCENE: &str = "scenes/cornell-spheres/tessellated.toml";
+pub const SPLAT_SCENE: &str = "scenes/cornell-spheres/analytic.toml";
 
 pub fn parse(args: &[String]) -> Result<Cmd, String> {
     let a: Vec<&str> = args.iter().map(String::as_str).collect();
@@ -82,14 +86,18 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
         )),
         [
             "bench",
-            what @ ("rays" | "photons" | "store" | "knn"),
+            what @ ("rays" | "photons" | "store" | "knn" | "splat"),
             rest @ ..,
         ] => {
             let mut out = vec![format!("bench-{what}")];
             // The scene benchmarks take a scene first; without one, the worksheet's.
-            let wants_scene = matches!(*what, "rays" | "photons");
-            if wants_scene && rest.first().is_none_or(|s| s.starts_with("--")) {
-                out.push(DEFAULT_SCENE.into());
+            if rest.first().is_none_or(|s| s.starts_with("--")) {
+                match *what {
+                    "rays" | "photons" => out.push(DEFAULT_SCENE.into()),
+                    // Splatting measures the worksheet's caustics on exact spheres.
+                    "splat" => out.push(SPLAT_SCENE.into()),
+                    _ => {}
+                }
             }
             out.extend(rest.iter().map(|s| s.to_string()));
             Ok(Cmd::Bench(Bench {

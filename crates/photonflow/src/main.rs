@@ -50,6 +50,15 @@ enum Cmd {
         #[arg(long, default_value = "out/bench")]
         dir: PathBuf,
     },
+    /// Caustic photons traced with differentials and splatted onto eye vertices: photons/s on
+    /// 1 and 2 threads, eye vertices, peak memory.
+    BenchSplat {
+        scene: PathBuf,
+        #[arg(long, default_value_t = 1_000_000)]
+        photons: u64,
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+    },
     /// k-NN queries/s for k = 50, 250, 1000 for each index.
     BenchKnn {
         #[arg(long, default_value_t = 1_000_000)]
@@ -377,6 +386,11 @@ fn run(cmd: Cmd) -> Result<(), String> {
             runs,
         } => pipeline::bench::photons(&scene, photons, runs),
         Cmd::BenchStore { photons, dir } => pipeline::bench::store(photons, &dir),
+        Cmd::BenchSplat {
+            scene,
+            photons,
+            runs,
+        } => pipeline::bench::splat(&scene, photons, runs),
         Cmd::BenchKnn { photons, queries } => pipeline::bench::knn(photons, queries),
         Cmd::Worksheet {
             scene,

@@ -233,3 +233,79 @@ pub fn knn(photons: usize, queries: usize) -> Result<(), String> {
     }
     Ok(())
 }
+
+/// Peak resident memory of this process so far (Linux `VmHWM`), in MiB; `None` elsewhere.
+fn peak_rss_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
+}
+
+/// `bench-splat`: caustic photons traced with differentials and splatted onto the eye
+/// vertices, photons/s on 1 and 2 threads (median of `runs`), the number of eye vertices, and
+/// the peak memory before and after splatting ten times more photons (flat if no photon is
+/// kept).
+pub fn splat(path: &Path, photons: u64, runs: usize) -> Result<(), String> {
+    use crate::splat::{EyeIndex, Splatter};
+    let s = scene::Scene::load(path).map_err(|e| e.to_string())?;
+    let settings = crate::Settings::new(&s, &crate::Overrides::default())?;
+    let sp = settings.estimate.splat;
+    let mut params = settings.emit.clone();
+    params.photons = photons;
+    let t0 = Instant::now();
+    let vertices = eye::eye_vertices(
+        &s,
+        &eye::VertexOptions {
+            spp: settings.estimate.spp,
+            splits: sp.splits,
+            threads: None,
+        },
+    );
+    let eyes = EyeIndex::new(vertices);
+    println!(
+        "scene {}, {} eye vertices in {:.3} s, {photons} caustic photon paths per run, median of {runs}",
+        path.display(),
+        eyes.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    let (w, h) = (s.camera.width as usize, s.camera.height as usize);
+    let splatter = Splatter {
+        scene: &s,
+        params: &params,
+        settings: &sp,
+        eyes: &eyes,
+    };
+    for threads in [1usize, 2] {
+        let mut rates = Vec::new();
+        for run in 0..runs.max(1) {
+            let mut image = vec![glam::DVec3::ZERO; w * h];
+            let stats = splatter.pass(run as u64, &mut image, threads, &|_| {})?;
+            rates.push(photons as f64 / stats.seconds);
+        }
+        rates.sort_by(f64::total_cmp);
+        println!(
+            "splat, {threads} thread(s): {:6.3} M photon paths/s",
+            rates[rates.len() / 2] / 1e6
+        );
+    }
+    let before = peak_rss_mib();
+    let mut many = params.clone();
+    many.photons = photons * 10;
+    let mut image = vec![glam::DVec3::ZERO; w * h];
+    Splatter {
+        scene: &s,
+        params: &many,
+        settings: &sp,
+        eyes: &eyes,
+    }
+    .pass(0, &mut image, 2, &|_| {})?;
+    match (before, peak_rss_mib()) {
+        (Some(a), Some(b)) => println!(
+            "peak memory: {a:.1} MiB after {photons} photons per pass, {b:.1} MiB after {} in one pass",
+            photons * 10
+        ),
+        _ => println!("peak memory: not available on this system"),
+    }
+    Ok(())
+}
