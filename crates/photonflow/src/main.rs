@@ -245,6 +245,7 @@ impl PhotonArgs {
             gather_cache: self.gather_cache,
             caustics: None,
             passes: self.passes,
+            splat_photons: None,
             time: self.time,
         }
     }

@@ -116,6 +116,8 @@ pub struct Overrides {
     pub caustics: Option<bool>,
     /// Photon passes of the progressive methods (`[estimate.splat] passes`).
     pub passes: Option<u32>,
+    /// Caustic paths per splatting pass (`[estimate.splat] photons`).
+    pub splat_photons: Option<u64>,
     /// Stop the progressive methods' passes once this many seconds have passed (after at
     /// least one); not a setting of the scene file, which records the passes made instead.
     pub time: Option<f64>,
@@ -148,16 +150,16 @@ impl Settings {
         if let Some(n) = o.photons {
             emit.photons = n;
         }
-        let photon_maps = crate::methods::spec(method).photon_maps;
+        let spec = crate::methods::spec(method);
         if let Some(spp) = o.spp {
-            if photon_maps {
+            if spec.estimate_spp {
                 estimate.spp = spp;
             } else {
                 render.spp = spp;
             }
         }
         if let Some(c) = o.caustics {
-            if photon_maps {
+            if spec.estimate_spp {
                 return Err(format!(
                     "--no-caustics applies to the path tracer; {method} takes caustics from \
                      photons"
@@ -190,6 +192,9 @@ impl Settings {
         if let Some(p) = o.passes {
             estimate.splat.passes = p;
         }
+        if let Some(n) = o.splat_photons {
+            estimate.splat.photons = n;
+        }
         if let Some(t) = o.time
             && !(t > 0.0 && t.is_finite())
         {
@@ -208,7 +213,7 @@ impl Settings {
 
     /// Samples per pixel of the method.
     pub fn spp(&self) -> u32 {
-        if crate::methods::spec(self.method).photon_maps {
+        if crate::methods::spec(self.method).estimate_spp {
             self.estimate.spp
         } else {
             self.render.spp

@@ -107,9 +107,11 @@ impl CountKind {
 /// What the rest of the program needs to know of a method.
 pub struct MethodSpec {
     pub render: RenderFn,
-    /// It reads photon maps: `estimate` may run it from cached photon sets, and its samples
-    /// per pixel are `[estimate] spp` (else `[render] spp`).
+    /// It reads photon maps: `estimate` may run it from cached photon sets.
     pub photon_maps: bool,
+    /// Its samples per pixel (and `--spp`) are `[estimate] spp` (else `[render] spp`, the
+    /// path tracer's).
+    pub estimate_spp: bool,
     /// Its progress counts splatted photons (else pixel samples).
     pub splat_progress: bool,
 }
@@ -118,16 +120,20 @@ type RenderFn = fn(&Run, &(dyn Fn(u64) + Sync)) -> Result<Rendered, String>;
 
 /// The one `match` on `scene::Method`.
 pub fn spec(method: Method) -> MethodSpec {
-    let (render, photon_maps, splat_progress): (RenderFn, bool, bool) = match method {
-        Method::Path => (path::render, false, false),
-        Method::GlobalDirect => (global_direct::render, true, false),
-        Method::FinalGather => (final_gather::render, true, false),
-        Method::CausticSplat => (caustic_splat::render, false, true),
-        Method::PathSplat => (path_splat::render, false, false),
-    };
+    // (render, photon maps, estimate spp, splat progress)
+    let (render, photon_maps, estimate_spp, splat_progress): (RenderFn, bool, bool, bool) =
+        match method {
+            Method::Path => (path::render, false, false, false),
+            Method::GlobalDirect => (global_direct::render, true, true, false),
+            Method::FinalGather => (final_gather::render, true, true, false),
+            Method::CausticSplat => (caustic_splat::render, false, true, true),
+            // The path tracer's spp; its splat's eye vertices take `[estimate] spp`.
+            Method::PathSplat => (path_splat::render, false, false, false),
+        };
     MethodSpec {
         render,
         photon_maps,
+        estimate_spp,
         splat_progress,
     }
 }
