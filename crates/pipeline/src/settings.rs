@@ -40,6 +40,9 @@ pub struct SplatSettings {
     pub max_radius: f32,
     /// Dielectric hits at which eye paths follow both reflection and refraction.
     pub splits: u32,
+    /// Isotropic splatting with this fixed radius in scene units instead of the photon
+    /// differentials' footprints (0: differentials). For comparisons.
+    pub isotropic_radius: f32,
     /// Photon passes: pass `j` traces `photons` new paths from streams `(seed, j, i)`; the
     /// layer is their mean. A run stopped by a time budget records the passes it made.
     pub passes: u32,
@@ -52,6 +55,7 @@ impl Default for SplatSettings {
             photons: 0,
             max_radius: 0.0,
             splits: 2,
+            isotropic_radius: 0.0,
             passes: 1,
         }
     }
@@ -282,6 +286,12 @@ impl Settings {
             return Err(format!(
                 "estimate.splat.scale = {} must be in (0, 1000]",
                 sp.scale
+            ));
+        }
+        if !(sp.isotropic_radius >= 0.0 && sp.isotropic_radius.is_finite()) {
+            return Err(format!(
+                "estimate.splat.isotropic_radius = {} must be finite and >= 0",
+                sp.isotropic_radius
             ));
         }
         if !(sp.max_radius >= 0.0 && sp.max_radius.is_finite()) {

@@ -76,11 +76,13 @@ pub fn footprint(
 }
 
 /// Adds what `photons` deposit at the eye vertices to `out`, as `(pixel, radiance)` pairs
-/// in photon order, then vertex order.
+/// in photon order, then vertex order. `isotropic > 0` replaces every footprint by a disc of
+/// that radius (the fixed-radius splatting that differentials improve on).
 pub fn splat(
     eyes: &EyeIndex,
     photons: &[CausticPhoton],
     max_radius: f32,
+    isotropic: f32,
     scratch: &mut Scratch,
     out: &mut Vec<(u32, DVec3)>,
 ) {
@@ -88,7 +90,20 @@ pub fn splat(
         if !p.flux.is_finite() {
             continue;
         }
-        let Some(f) = footprint(eyes, p, max_radius, scratch) else {
+        let f = if isotropic > 0.0 {
+            let frame = math::Frame::from_z(p.normal);
+            Footprint::new(
+                p.position,
+                p.normal,
+                isotropic * frame.s,
+                isotropic * frame.t,
+                isotropic,
+                isotropic,
+            )
+        } else {
+            footprint(eyes, p, max_radius, scratch)
+        };
+        let Some(f) = f else {
             continue;
         };
         eyes.index.within(p.position, f.radius(), &mut scratch.near);
@@ -149,7 +164,14 @@ impl Splatter<'_> {
             let photons = emit::trace_caustics(scene, params, s.scale, pass, range);
             let mut out = Vec::new();
             let mut scratch = Scratch::default();
-            splat(eyes, &photons, max_r, &mut scratch, &mut out);
+            splat(
+                eyes,
+                &photons,
+                max_r,
+                s.isotropic_radius,
+                &mut scratch,
+                &mut out,
+            );
             (n, out)
         };
         flow::run_chunks(
