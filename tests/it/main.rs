@@ -8,7 +8,11 @@
 //! - `photon_maps`: the photon-map methods through the pipeline library, trace to image: the
 //!   furnace against `Le / (1 - rho)` with the predicted k-NN bias, boundary correction on a
 //!   square and a sphere, global-direct and final gathering against the path tracer.
+//! - `splat`: photon differential splatting through the pipeline library: the splatted
+//!   caustic and `path+splat` against the path tracer on the worksheet scene, bounded chunks
+//!   in flight, a hostile scene (finite pixels, flux kept), the same bits on 1 and 2 threads.
 
 mod cornell;
 mod photon_maps;
 mod photons;
+mod splat;

@@ -460,7 +460,12 @@ pub fn caustic_region(scene: &Scene, radii: f32) -> Mask {
         .geometry
         .spheres()
         .iter()
-        .filter(|s| matches!(scene.materials[s.material as usize], Material::Dielectric { .. }))
+        .filter(|s| {
+            matches!(
+                scene.materials[s.material as usize],
+                Material::Dielectric { .. }
+            )
+        })
         .map(|s| (s.center, s.radius))
         .collect();
     Mask::from_fn(w, h, |x, y| {
