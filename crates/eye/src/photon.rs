@@ -8,7 +8,7 @@ use crate::RenderOptions;
 use crate::render::render_layers;
 use bsdf::{Bsdf, Lambertian, TransportMode};
 use film::Film;
-use geom::{Hit, Ray};
+use geom::Ray;
 use glam::Vec3;
 use math::{Frame, Rng, warp};
 use scene::{Scene, sides_agree};
@@ -42,12 +42,16 @@ pub fn render_global_direct(
         max_depth: scene.render().max_depth,
     };
     render_layers(scene, opts, ["emitted", "global"], progress, &|ray, rng| {
-        let (emitted, first) = ctx.to_diffuse(ray, rng, true);
-        let global = first.map_or(Vec3::ZERO, |v| {
-            v.beta * v.albedo / std::f32::consts::PI
-                * maps.irradiance(MapLookup::Global, v.hit.point.p, v.n)
-        });
-        [emitted, global]
+        ctx.with_eye_vertices(ray, rng, |emitted, verts, _| {
+            let global: Vec3 = verts
+                .iter()
+                .map(|v| {
+                    v.beta * v.albedo / std::f32::consts::PI
+                        * maps.irradiance(MapLookup::Global, v.hit.point.p, v.n)
+                })
+                .sum();
+            [emitted, global]
+        })
     })
 }
 
@@ -73,27 +77,29 @@ pub fn render_final_gather(
         ["emitted", "direct", "caustic", "indirect"],
         progress,
         &|ray, rng| {
-            let (emitted, first) = ctx.to_diffuse(ray, rng, true);
-            let Some(v) = first else {
-                return [emitted, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO];
-            };
-            let brdf = v.beta * v.albedo / std::f32::consts::PI;
-            let direct = ctx.direct(&v, rng) * brdf;
-            let caustic = brdf * maps.irradiance(MapLookup::Caustic, v.hit.point.p, v.n);
-            let indirect = ctx.gather(&v, rays, rng) * (v.beta * v.albedo);
-            [emitted, direct, caustic, indirect]
+            ctx.with_eye_vertices(ray, rng, |emitted, verts, rng| {
+                let mut out = [emitted, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO];
+                for v in verts {
+                    let brdf = v.beta * v.albedo / std::f32::consts::PI;
+                    out[1] += ctx.direct(v, rng) * brdf;
+                    out[2] += brdf * maps.irradiance(MapLookup::Caustic, v.hit.point.p, v.n);
+                    out[3] += ctx.gather(v, rays, rng) * (v.beta * v.albedo);
+                }
+                out
+            })
         },
     )
 }
 
 /// The first diffuse vertex of an eye path.
-struct Vertex {
-    hit: Hit,
-    /// Shading normal turned towards the incoming ray.
-    n: Vec3,
-    albedo: Vec3,
-    /// Throughput of the specular chain that led here.
-    beta: Vec3,
+use crate::vertices::Found as Vertex;
+
+/// Dielectric hits at which camera paths of the photon-map passes follow both Fresnel
+/// branches (the course framework's two splits; the splat's eye vertices use the same rule).
+const SPLITS: u32 = 2;
+
+thread_local! {
+    static VERTICES: std::cell::RefCell<Vec<Vertex>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 struct Ctx<'a> {
@@ -103,6 +109,21 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
+    /// The camera path's first diffuse vertices (Fresnel-split at the first [`SPLITS`]
+    /// dielectric hits) and the emission seen on the way, handed to `f`.
+    fn with_eye_vertices<const N: usize>(
+        &self,
+        ray: Ray,
+        rng: &mut Rng,
+        f: impl FnOnce(Vec3, &[Vertex], &mut Rng) -> [Vec3; N],
+    ) -> [Vec3; N] {
+        VERTICES.with_borrow_mut(|verts| {
+            verts.clear();
+            let emitted = crate::vertices::first_diffuse(self.scene, ray, SPLITS, rng, true, verts);
+            f(emitted, verts, rng)
+        })
+    }
+
     /// Follows `ray` through specular surfaces (Fresnel-chosen at glass) to the first diffuse
     /// vertex. Returns emission seen on the way (only when `count_emission`) and the vertex.
     fn to_diffuse(
@@ -143,6 +164,8 @@ impl Ctx<'_> {
                             n,
                             albedo,
                             beta,
+                            length: 0.0,
+                            wo,
                         }),
                     );
                 }

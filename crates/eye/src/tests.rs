@@ -549,3 +549,50 @@ fn final_gather_in_a_furnace_gives_the_rendering_equation_terms() {
         "standard error {se} too large to mean anything"
     );
 }
+
+/// Through glass the photon-map passes follow both Fresnel branches at the first two
+/// dielectric hits, so a 1-spp image of the glass sphere is smooth instead of speckled: with
+/// a constant global map, pixels inside the sphere's outline differ only by geometry. The
+/// relative spread between horizontally adjacent sphere pixels, measured: 0.007 with splits,
+/// 0.286 when each pixel follows one Fresnel-chosen branch (`SPLITS = 0`).
+#[test]
+fn global_map_through_glass_is_not_speckled_at_one_sample() {
+    let scene = scene_text("plane-light/caustic.toml", CAUSTIC_SCENE);
+    let opts = RenderOptions {
+        spp: 1,
+        caustics: true,
+        threads: None,
+        tile: 8,
+    };
+    let maps = ConstantMaps {
+        global: Vec3::ONE,
+        caustic: Vec3::ZERO,
+    };
+    let film = crate::render_global_direct(&scene, &opts, &maps, &|_| {});
+    let g = film
+        .layer("global")
+        .unwrap()
+        .resolve(Normalize::Constant(1.0));
+    let on_sphere = |x: usize, y: usize| {
+        let ray = scene.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
+        let centre = Vec3::new(0.0, 0.8, 0.0);
+        // Well inside the outline (the rim refracts to grazing, anything goes there).
+        let t = (centre - ray.o).dot(ray.d);
+        (ray.o + t * ray.d - centre).length() < 0.35
+    };
+    let (mut diff, mut sum, mut n) = (0.0f64, 0.0f64, 0);
+    for y in 0..32 {
+        for x in 0..31 {
+            if on_sphere(x, y) && on_sphere(x + 1, y) {
+                let (a, b) = (g.get(x, y)[1] as f64, g.get(x + 1, y)[1] as f64);
+                diff += (a - b).abs();
+                sum += 0.5 * (a + b);
+                n += 1;
+            }
+        }
+    }
+    assert!(n > 20, "{n} pixel pairs on the sphere");
+    let spread = diff / sum;
+    eprintln!("glass: relative spread between neighbours {spread:.3} over {n} pairs");
+    assert!(spread < 0.05, "speckled: {spread}");
+}

@@ -6,7 +6,7 @@
 //! glass sphere are not speckled.
 
 use bsdf::{Bsdf, TransportMode};
-use geom::Ray;
+use geom::{Hit, Ray};
 use glam::Vec3;
 use math::{Frame, Rng};
 use rayon::prelude::*;
@@ -53,28 +53,28 @@ pub fn eye_vertices(scene: &Scene, opts: &VertexOptions) -> Vec<EyeVertex> {
     let per_sample = pixel_angle / (spp as f32).sqrt();
     let row = |y: usize| -> Vec<EyeVertex> {
         let mut out = Vec::new();
+        let mut found = Vec::new();
         for x in 0..w {
             let pixel = (y * w + x) as u64;
             for s in 0..spp as u64 {
                 let mut rng = Rng::for_index(scene.seed(), pixel * spp as u64 + s);
                 let [jx, jy] = rng.uniform2();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
-                let start = Branch {
-                    ray,
-                    beta: Vec3::splat(1.0 / spp as f32),
-                    length: 0.0,
-                    depth: 0,
-                    splits: 0,
-                };
-                follow(
-                    scene,
-                    opts,
-                    start,
-                    pixel as u32,
-                    per_sample,
-                    &mut rng,
-                    &mut out,
-                );
+                found.clear();
+                first_diffuse(scene, ray, opts.splits, &mut rng, false, &mut found);
+                for f in &found {
+                    let ng = f.hit.point.n;
+                    let facing = if f.wo.dot(ng) >= 0.0 { ng } else { -ng };
+                    out.push(EyeVertex {
+                        pixel: pixel as u32,
+                        p: f.hit.point.p,
+                        ng: facing,
+                        surface: surface_id(f.hit.prim),
+                        weight: f.beta * f.albedo / (std::f32::consts::PI * spp as f32),
+                        // A grazing view stretches the pixel's footprint (bounded at 1/0.1).
+                        spacing: f.length * per_sample / f.wo.dot(facing).max(0.1),
+                    });
+                }
             }
         }
         out
@@ -89,64 +89,97 @@ pub fn eye_vertices(scene: &Scene, opts: &VertexOptions) -> Vec<EyeVertex> {
     }
 }
 
+/// A first diffuse vertex as the eye passes use it.
+pub(crate) struct Found {
+    pub hit: Hit,
+    /// Shading normal turned towards the incoming ray.
+    pub n: Vec3,
+    pub albedo: Vec3,
+    /// Throughput of the specular chain that led here (Fresnel weights of split branches
+    /// included).
+    pub beta: Vec3,
+    /// Path length from the start of the chain.
+    pub length: f32,
+    /// Unit direction back along the ray that arrived.
+    pub wo: Vec3,
+}
+
 struct Branch {
     ray: Ray,
     beta: Vec3,
-    /// Path length from the camera so far.
     length: f32,
     depth: u32,
     splits: u32,
 }
 
-/// Follows one eye path through specular surfaces, depth first, pushing the diffuse vertices
-/// it reaches.
-fn follow(
+/// Follows `ray` through specular surfaces to its first diffuse vertices, depth first
+/// (reflection before refraction), pushing them to `out`; at the first `splits` dielectric
+/// hits both Fresnel branches are followed with weights R and T/η², later ones choose one
+/// with Fresnel probability. Every hit draws three numbers from `rng` whether it uses them or
+/// not (the layout every eye pass shares), so without a split the walk is the single path
+/// the photon-map passes have always followed. Returns the emission met on the way, each
+/// light hit weighted by its branch's throughput, when `count_emission`.
+pub(crate) fn first_diffuse(
     scene: &Scene,
-    opts: &VertexOptions,
-    start: Branch,
-    pixel: u32,
-    per_sample: f32,
+    ray: Ray,
+    splits: u32,
     rng: &mut Rng,
-    out: &mut Vec<EyeVertex>,
-) {
+    count_emission: bool,
+    out: &mut Vec<Found>,
+) -> Vec3 {
     let max_depth = scene.render().max_depth;
-    let mut stack = vec![start];
+    let lights = &scene.light_table;
+    let mut emitted = Vec3::ZERO;
+    let mut stack = vec![Branch {
+        ray,
+        beta: Vec3::ONE,
+        length: 0.0,
+        depth: 0,
+        splits: 0,
+    }];
     while let Some(b) = stack.pop() {
-        if b.depth > max_depth || b.beta == Vec3::ZERO || !b.beta.is_finite() {
+        if b.depth > max_depth {
             continue;
         }
         let Some(hit) = scene.geometry.intersect(&b.ray) else {
             continue;
         };
+        if count_emission && let Some(light) = lights.light_of(hit.prim) {
+            emitted += b.beta * lights.le(light, b.ray.d);
+        }
+        let wo = -b.ray.d.normalize();
+        let (u_lobe, u_dir) = (rng.uniform(), rng.uniform2());
         // Black surfaces absorb.
         let Some(bsdf) = scene.bsdf(hit.material) else {
             continue;
         };
-        let d = b.ray.d.normalize();
-        let wo = -d;
-        let ng = hit.point.n;
         let length = b.length + hit.t * b.ray.d.length();
         if let Bsdf::Lambertian(l) = bsdf {
-            let cos = wo.dot(ng).abs().max(0.1);
-            out.push(EyeVertex {
-                pixel,
-                p: hit.point.p,
-                ng: if wo.dot(ng) >= 0.0 { ng } else { -ng },
-                surface: surface_id(hit.prim),
-                weight: b.beta * l.albedo / std::f32::consts::PI,
-                spacing: length * per_sample / cos,
+            // Shading normals face the geometric one (geom), so this turns both to the side
+            // the ray came from.
+            let n = if wo.dot(hit.point.n) >= 0.0 {
+                hit.ns
+            } else {
+                -hit.ns
+            };
+            out.push(Found {
+                hit,
+                n,
+                albedo: l.albedo,
+                beta: b.beta,
+                length,
+                wo,
             });
             continue;
         }
         let frame = Frame::from_z(hit.ns);
         let wo_l = frame.to_local(wo);
-        let split = matches!(bsdf, Bsdf::Dielectric(_)) && b.splits < opts.splits;
-        // Both Fresnel branches (weights R and T / eta^2), or one chosen by `uc`.
-        let (uc, u) = (rng.uniform(), rng.uniform2());
+        let split = matches!(bsdf, Bsdf::Dielectric(_)) && b.splits < splits;
         let samples = if split {
-            let r = bsdf.sample(wo_l, 0.0, u, TransportMode::Radiance);
-            let t = bsdf.sample(wo_l, 1.0, u, TransportMode::Radiance);
-            // Pushed refraction first so reflection is followed first (the stack is LIFO).
+            // Both branches, weighted by what each carries (f |cos|, no pdf); the stack is
+            // LIFO, so refraction goes in first and reflection is followed first.
+            let r = bsdf.sample(wo_l, 0.0, u_dir, TransportMode::Radiance);
+            let t = bsdf.sample(wo_l, 1.0, u_dir, TransportMode::Radiance);
             [
                 t.filter(|t| t.is_transmission())
                     .map(|t| (t, t.f * t.wi.z.abs())),
@@ -155,23 +188,30 @@ fn follow(
             ]
         } else {
             [
-                bsdf.sample(wo_l, uc, u, TransportMode::Radiance)
+                bsdf.sample(wo_l, u_lobe, u_dir, TransportMode::Radiance)
                     .map(|s| (s, s.weight())),
                 None,
             ]
         };
         for (s, weight) in samples.into_iter().flatten() {
             let wi = frame.to_world(s.wi);
-            if !sides_agree(wo, wi, ng, wo_l, s.wi) {
+            // As in the path tracer: end the path where shading and geometric normals
+            // disagree on reflection vs transmission (pbrt-v4 §10.1.1).
+            if !sides_agree(wo, wi, hit.point.n, wo_l, s.wi) {
+                continue;
+            }
+            let beta = b.beta * weight;
+            if beta == Vec3::ZERO || !beta.is_finite() {
                 continue;
             }
             stack.push(Branch {
                 ray: hit.point.spawn_ray(wi),
-                beta: b.beta * weight,
+                beta,
                 length,
                 depth: b.depth + 1,
                 splits: b.splits + split as u32,
             });
         }
     }
+    emitted
 }
