@@ -32,7 +32,16 @@ const ALLOWED: &[(&str, &[&str])] = &[
     (
         "pipeline",
         &[
-            "math", "geom", "scene", "bsdf", "film", "store", "eye", "emit", "density",
+            "math",
+            "geom",
+            "scene",
+            "bsdf",
+            "film",
+            "store",
+            "eye",
+            "emit",
+            "density",
+            "composite",
         ],
     ),
     ("xtask", &[]),

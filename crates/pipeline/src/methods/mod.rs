@@ -87,22 +87,9 @@ pub struct Rendered {
     pub passes: Option<u32>,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum CountKind {
-    /// Samples per pixel.
-    Spp,
-    /// Photon paths emitted.
-    PhotonPaths,
-}
-
-impl CountKind {
-    pub fn name(self) -> &'static str {
-        match self {
-            CountKind::Spp => "spp",
-            CountKind::PhotonPaths => "photon_paths",
-        }
-    }
-}
+/// What a layer's count counts: the compositing stage's own type, so `image.json` is spelled
+/// in one place.
+pub use composite::CountKind;
 
 /// What the rest of the program needs to know of a method.
 pub struct MethodSpec {
