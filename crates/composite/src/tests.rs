@@ -673,11 +673,13 @@ fn runs_sharing_a_seed_are_not_averaged() {
         i.meta.seed = Some(seed);
         i
     };
-    refused(
-        vec![seeded("a", 7, [1.0; 3]), seeded("b", 7, [2.0; 3])],
-        "a",
-        "seed 7",
-    );
+    // The message names both runs, whichever sorts first.
+    let both = vec![
+        seeded("first/run", 7, [1.0; 3]),
+        seeded("second/run", 7, [2.0; 3]),
+    ];
+    refused(both.clone(), "first/run", "seed 7");
+    refused(both, "second/run", "seed 7");
     // Distinct seeds are independent runs: averaged.
     let c = composite(vec![seeded("a", 7, [1.0; 3]), seeded("b", 8, [2.0; 3])]).unwrap();
     assert_eq!(c.image.get(0, 0), [1.5; 3]);

@@ -11,11 +11,11 @@
 
 use crate::diff::{emit_diff, mesh_dn, reflect_diff, refract_diff, sphere_dn, transfer};
 use crate::{EMIT_STREAM, EmitParams};
-use bsdf::{Bsdf, TransportMode};
+use bsdf::Bsdf;
 use geom::{Hit, Prim};
 use glam::Vec3;
-use math::{Frame, Rng};
-use scene::{Scene, sides_agree, surface_id};
+use math::Rng;
+use scene::{Scene, surface_id};
 use std::ops::Range;
 
 /// A caustic photon at its first diffuse hit, with its footprint.
@@ -143,17 +143,7 @@ fn trace_one(
                 b: rd.dodv,
             });
         }
-        let wo = -d;
-        let frame = Frame::from_z(hit.ns);
-        let wo_local = frame.to_local(wo);
-        if wo_local.z * wo.dot(ng) <= 0.0 {
-            return None;
-        }
-        let s = bsdf.sample(wo_local, uc, u, TransportMode::Importance)?;
-        let wi = frame.to_world(s.wi).normalize();
-        if !sides_agree(wo, wi, ng, wo_local, s.wi) {
-            return None;
-        }
+        let (wi, s) = crate::trace::scatter(&hit, bsdf, d, uc, u)?;
         flux *= s.weight();
         let (dndu, dndv) = normal_derivatives(scene, &hit, rd.dodu, rd.dodv);
         let n = hit.ns;

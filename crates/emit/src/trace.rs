@@ -113,6 +113,30 @@ pub fn trace_parallel(scene: &Scene, params: &EmitParams, plan: &Plan, chunk: u6
     out
 }
 
+/// A photon's bounce at `hit` (arriving along unit `d`): the BSDF sampled in
+/// [`TransportMode::Importance`] in the shading frame of `hit.ns`, with sides decided by the
+/// geometric normal; `None` (absorbed) when the two normals disagree about the side the
+/// photon arrives on or leaves by, so no photon leaks through a surface. Returns the new
+/// unit direction and the sample.
+pub(crate) fn scatter(
+    hit: &geom::Hit,
+    bsdf: Bsdf,
+    d: Vec3,
+    uc: f32,
+    u: [f32; 2],
+) -> Option<(Vec3, bsdf::BsdfSample)> {
+    let ng = hit.point.n;
+    let wo = -d;
+    let frame = Frame::from_z(hit.ns);
+    let wo_local = frame.to_local(wo);
+    if wo_local.z * wo.dot(ng) <= 0.0 {
+        return None;
+    }
+    let s = bsdf.sample(wo_local, uc, u, TransportMode::Importance)?;
+    let wi = frame.to_world(s.wi).normalize();
+    sides_agree(wo, wi, ng, wo_local, s.wi).then_some((wi, s))
+}
+
 struct Tracer<'a> {
     scene: &'a Scene,
     params: &'a EmitParams,
@@ -165,22 +189,9 @@ impl Tracer<'_> {
                 flux = flux * albedo / survive;
                 diffuse_bounces += 1;
             }
-            // Shading frame from the shading normal; sides from the geometric one.
-            let ng = hit.point.n;
-            let wo = -d;
-            let cos_o = wo.dot(ng);
-            let frame = Frame::from_z(hit.ns);
-            let wo_local = frame.to_local(wo);
-            if wo_local.z * cos_o <= 0.0 {
-                return;
-            }
-            let Some(s) = bsdf.sample(wo_local, uc, u, TransportMode::Importance) else {
+            let Some((wi, s)) = scatter(&hit, bsdf, d, uc, u) else {
                 return;
             };
-            let wi = frame.to_world(s.wi).normalize();
-            if !sides_agree(wo, wi, ng, wo_local, s.wi) {
-                return;
-            }
             if s.is_specular() {
                 flux *= s.weight();
                 specular_bounces += 1;

@@ -6,12 +6,11 @@
 
 use crate::RenderOptions;
 use crate::render::render_layers;
-use bsdf::{Bsdf, Lambertian, TransportMode};
 use film::Film;
 use geom::Ray;
 use glam::Vec3;
 use math::{Frame, Rng, warp};
-use scene::{Scene, sides_agree};
+use scene::Scene;
 
 /// Which photon map a lookup reads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,11 +35,7 @@ pub fn render_global_direct(
     maps: &dyn Irradiance,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Film {
-    let ctx = Ctx {
-        scene,
-        maps,
-        max_depth: scene.render().max_depth,
-    };
+    let ctx = Ctx { scene, maps };
     render_layers(scene, opts, ["emitted", "global"], progress, &|ray, rng| {
         ctx.with_eye_vertices(ray, rng, |emitted, verts, _| {
             let global: Vec3 = verts
@@ -66,11 +61,7 @@ pub fn render_final_gather(
     maps: &dyn Irradiance,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Film {
-    let ctx = Ctx {
-        scene,
-        maps,
-        max_depth: scene.render().max_depth,
-    };
+    let ctx = Ctx { scene, maps };
     render_layers(
         scene,
         opts,
@@ -92,7 +83,7 @@ pub fn render_final_gather(
 }
 
 /// The first diffuse vertex of an eye path.
-use crate::vertices::Found as Vertex;
+use crate::vertices::{Found as Vertex, first_diffuse};
 
 /// Dielectric hits at which camera paths of the photon-map passes follow both Fresnel
 /// branches (the course framework's two splits; the splat's eye vertices use the same rule).
@@ -105,7 +96,6 @@ thread_local! {
 struct Ctx<'a> {
     scene: &'a Scene,
     maps: &'a dyn Irradiance,
-    max_depth: u32,
 }
 
 impl Ctx<'_> {
@@ -119,78 +109,9 @@ impl Ctx<'_> {
     ) -> [Vec3; N] {
         VERTICES.with_borrow_mut(|verts| {
             verts.clear();
-            let emitted = crate::vertices::first_diffuse(self.scene, ray, SPLITS, rng, true, verts);
+            let emitted = first_diffuse(self.scene, ray, SPLITS, rng, true, &mut |v| verts.push(v));
             f(emitted, verts, rng)
         })
-    }
-
-    /// Follows `ray` through specular surfaces (Fresnel-chosen at glass) to the first diffuse
-    /// vertex. Returns emission seen on the way (only when `count_emission`) and the vertex.
-    fn to_diffuse(
-        &self,
-        mut ray: Ray,
-        rng: &mut Rng,
-        count_emission: bool,
-    ) -> (Vec3, Option<Vertex>) {
-        let mut beta = Vec3::ONE;
-        let mut emitted = Vec3::ZERO;
-        for _ in 0..=self.max_depth {
-            let Some(hit) = self.scene.geometry.intersect(&ray) else {
-                break;
-            };
-            let lights = &self.scene.light_table;
-            if count_emission && let Some(light) = lights.light_of(hit.prim) {
-                emitted += beta * lights.le(light, ray.d);
-            }
-            let wo = -ray.d.normalize();
-            let (u_lobe, u_dir) = (rng.uniform(), rng.uniform2());
-            // Black surfaces absorb: the path ends with nothing to estimate.
-            let Some(bsdf) = self.scene.bsdf(hit.material) else {
-                break;
-            };
-            match bsdf {
-                Bsdf::Lambertian(Lambertian { albedo }) => {
-                    // Shading normals face the geometric one (geom), so this turns both to
-                    // the side the ray came from.
-                    let n = if wo.dot(hit.point.n) >= 0.0 {
-                        hit.ns
-                    } else {
-                        -hit.ns
-                    };
-                    return (
-                        emitted,
-                        Some(Vertex {
-                            hit,
-                            n,
-                            albedo,
-                            beta,
-                            length: 0.0,
-                            wo,
-                        }),
-                    );
-                }
-                _ => {
-                    let frame = Frame::from_z(hit.ns);
-                    let wo_l = frame.to_local(wo);
-                    let Some(s) = bsdf.sample(wo_l, u_lobe, u_dir, TransportMode::Radiance) else {
-                        break;
-                    };
-                    let wi = frame.to_world(s.wi);
-                    // As in the path tracer: end the path where shading and geometric normals
-                    // disagree on reflection vs transmission (pbrt-v4 §10.1.1), so both passes
-                    // follow the same paths near smooth-shaded silhouettes.
-                    if !sides_agree(wo, wi, hit.point.n, wo_l, s.wi) {
-                        break;
-                    }
-                    beta *= s.weight();
-                    if beta == Vec3::ZERO {
-                        break;
-                    }
-                    ray = hit.point.spawn_ray(wi);
-                }
-            }
-        }
-        (emitted, None)
     }
 
     /// Irradiance at the vertex from the lights by one shadow ray (next-event estimation).
@@ -228,7 +149,10 @@ impl Ctx<'_> {
                 continue;
             }
             let ray = v.hit.point.spawn_ray(wi);
-            if let (_, Some(y)) = self.to_diffuse(ray, rng, false) {
+            // One Fresnel-chosen path per gather ray (no splits): its diffuse end, if any.
+            let mut end = None;
+            first_diffuse(self.scene, ray, 0, rng, false, &mut |y| end = Some(y));
+            if let Some(y) = end {
                 let e = self.maps.irradiance(MapLookup::Global, y.hit.point.p, y.n);
                 sum += (y.beta * y.albedo / std::f32::consts::PI * e).as_dvec3();
             }

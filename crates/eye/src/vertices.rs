@@ -61,7 +61,9 @@ pub fn eye_vertices(scene: &Scene, opts: &VertexOptions) -> Vec<EyeVertex> {
                 let [jx, jy] = rng.uniform2();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
                 found.clear();
-                first_diffuse(scene, ray, opts.splits, &mut rng, false, &mut found);
+                first_diffuse(scene, ray, opts.splits, &mut rng, false, &mut |f| {
+                    found.push(f)
+                });
                 for f in &found {
                     let ng = f.hit.point.n;
                     let facing = if f.wo.dot(ng) >= 0.0 { ng } else { -ng };
@@ -104,6 +106,7 @@ pub(crate) struct Found {
     pub wo: Vec3,
 }
 
+#[derive(Clone, Copy)]
 struct Branch {
     ray: Ray,
     beta: Vec3,
@@ -112,8 +115,14 @@ struct Branch {
     splits: u32,
 }
 
+/// Most dielectric splits one walk follows: the branches waiting on the stack are never more
+/// than the splits made plus the one being followed, so a fixed array holds them (the walk
+/// runs per pixel sample and per gather ray; it allocates nothing).
+pub(crate) const MAX_SPLITS: u32 = 16;
+
 /// Follows `ray` through specular surfaces to its first diffuse vertices, depth first
-/// (reflection before refraction), pushing them to `out`; at the first `splits` dielectric
+/// (reflection before refraction), handing them to `found`; at the first `splits` (at most
+/// [`MAX_SPLITS`]) dielectric
 /// hits both Fresnel branches are followed with weights R and T/η², later ones choose one
 /// with Fresnel probability. Every hit draws three numbers from `rng` whether it uses them or
 /// not (the layout every eye pass shares), so without a split the walk is the single path
@@ -125,19 +134,26 @@ pub(crate) fn first_diffuse(
     splits: u32,
     rng: &mut Rng,
     count_emission: bool,
-    out: &mut Vec<Found>,
+    found: &mut dyn FnMut(Found),
 ) -> Vec3 {
     let max_depth = scene.render().max_depth;
+    let splits = splits.min(MAX_SPLITS);
     let lights = &scene.light_table;
     let mut emitted = Vec3::ZERO;
-    let mut stack = vec![Branch {
+    let mut stack = [None::<Branch>; MAX_SPLITS as usize + 2];
+    stack[0] = Some(Branch {
         ray,
         beta: Vec3::ONE,
         length: 0.0,
         depth: 0,
         splits: 0,
-    }];
-    while let Some(b) = stack.pop() {
+    });
+    let mut len = 1;
+    while len > 0 {
+        len -= 1;
+        let Some(b) = stack[len].take() else {
+            continue;
+        };
         if b.depth > max_depth {
             continue;
         }
@@ -162,7 +178,7 @@ pub(crate) fn first_diffuse(
             } else {
                 -hit.ns
             };
-            out.push(Found {
+            found(Found {
                 hit,
                 n,
                 albedo: l.albedo,
@@ -204,13 +220,14 @@ pub(crate) fn first_diffuse(
             if beta == Vec3::ZERO || !beta.is_finite() {
                 continue;
             }
-            stack.push(Branch {
+            stack[len] = Some(Branch {
                 ray: hit.point.spawn_ray(wi),
                 beta,
                 length,
                 depth: b.depth + 1,
                 splits: b.splits + split as u32,
             });
+            len += 1;
         }
     }
     emitted
