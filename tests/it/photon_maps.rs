@@ -15,35 +15,9 @@ use glam::{DVec3, Vec3};
 use pipeline::maps::Maps;
 use pipeline::{Overrides, Photons, Rendered, Run, Settings};
 use scene::{Material, Method, Scene};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use store::{MapKind, PerKind};
-use tests::{load, scenes_dir};
-
-/// A scratch directory under the system's temporary directory, removed when dropped (also
-/// when a test fails).
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> TempDir {
-        let d = std::env::temp_dir().join(format!(
-            "photonflow-it-photon-maps-{name}-{}",
-            std::process::id()
-        ));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap_or_else(|e| panic!("{}: {e}", d.display()));
-        TempDir(d)
-    }
-
-    fn path(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+use tests::{TempDir, load, scenes_dir};
 
 /// Runs a method with `o` on photon sets already in `cache` (never traces), as the
 /// `estimate` command does.
@@ -218,7 +192,7 @@ fn furnace_global_direct_shows_le_over_one_minus_rho_with_the_predicted_knn_bias
     //   inside are uniform on the disc, where the kernel averages 1 / A: unbiased.
     // At k = 10 the box kernel's bias is 11% of the photon part, which the test resolves.
     let (scene, rho, le) = furnace();
-    let dir = TempDir::new("furnace-gd");
+    let dir = TempDir::new("photon-maps-furnace-gd");
     let stored = trace_furnace(&scene, dir.path());
     let k = 10;
     let r = knn_radius(&scene, stored, k);
@@ -295,7 +269,7 @@ fn furnace_final_gathering_shows_le_over_one_minus_rho_with_the_predicted_knn_bi
     // corner; with radii of 0.01 (k = 10) and 0.03 (k = 100) that darkens the image by at most
     // 0.15%, below the standard error here (0.27%).
     let (scene, rho, le) = furnace();
-    let dir = TempDir::new("furnace-fg");
+    let dir = TempDir::new("photon-maps-furnace-fg");
     let stored = trace_furnace(&scene, dir.path());
     // Every interior pixel counts: a pixel's gather rays land anywhere in the box, so two
     // pixels share photons only where their gather hits happen to fall within a disc of each
@@ -413,7 +387,7 @@ fn boundary_correction_restores_the_edges_and_corners_of_a_uniformly_lit_square(
     // finds its k photons in half a disc and so reads E0 / 2 (in a corner, a quarter disc:
     // E0 / 4), times the kernel's k-NN bias; the corrected one divides by the kernel mass the
     // probe rays find on the floor and reads E0 times that bias.
-    let dir = TempDir::new("square");
+    let dir = TempDir::new("photon-maps-square");
     let scene = scene_in(
         dir.path(),
         &[
@@ -523,7 +497,7 @@ fn boundary_correction_leaves_a_diffuse_sphere_alone() {
     // falls below the tangent plane by up to r^2 / 2 = 0.005: a probe band of 0.01 r (0.001)
     // misses all but the innermost ring and multiplied the estimate by about 4 (box kernel)
     // or 1.7 (Silverman's).
-    let dir = TempDir::new("sphere");
+    let dir = TempDir::new("photon-maps-sphere");
     let scene = scene_in(
         dir.path(),
         &[
@@ -747,7 +721,7 @@ const PATH_SPP: u32 = 1024;
 
 fn compare_worksheet(seed: u64) -> Vec<Comparison> {
     let scene = worksheet(seed);
-    let dir = TempDir::new(&format!("worksheet-{seed}"));
+    let dir = TempDir::new(&format!("photon-maps-worksheet-{seed}"));
     // The scene's own [photons] and [estimate] tables: 200 000 paths; k = 1000 (global) and
     // 250 (caustic), uniform kernel; final gathering through the irradiance cache (every 4th
     // global photon) with 16 gather rays.

@@ -20,33 +20,10 @@ use pipeline::settings::SplatSettings;
 use pipeline::splat::{EyeIndex, Splatter};
 use pipeline::{Overrides, Photons, Rendered, Run, Settings};
 use scene::{Method, Scene};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::OnceLock;
 use store::MapKind;
-use tests::scenes_dir;
-
-/// A scratch directory under the system's temporary directory, removed when dropped.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> TempDir {
-        let d =
-            std::env::temp_dir().join(format!("photonflow-it-splat-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap_or_else(|e| panic!("{}: {e}", d.display()));
-        TempDir(d)
-    }
-
-    fn path(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+use tests::{TempDir, scenes_dir};
 
 /// The worksheet scene (`scenes/cornell-spheres/analytic.toml`) at `res` x `res` pixels,
 /// with seed `seed` and `[estimate] spp = estimate_spp` (the splat's eye vertices per pixel).
@@ -490,7 +467,7 @@ fn splatting_keeps_a_bounded_number_of_chunks_alive_and_writes_no_photons() {
         );
     }
     // Through the method: no photon file appears in the cache directory it is given.
-    let dir = TempDir::new("cache");
+    let dir = TempDir::new("splat-cache");
     let o = Overrides {
         method: Some(Method::CausticSplat),
         photons: Some(100_000),
@@ -607,7 +584,7 @@ fn hostile_scene(dir: &Path, camera: &str) -> Scene {
 
 #[test]
 fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
-    let dir = TempDir::new("hostile");
+    let dir = TempDir::new("splat-hostile");
     let camera = "[camera]\neye = [7.0, 8.0, 9.0]\nlook_at = [0.0, 0.5, -1.0]\nvfov = 60.0\n\
                   width = 48\nheight = 48\n";
     let scene = hostile_scene(dir.path(), camera);
