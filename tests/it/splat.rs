@@ -327,7 +327,7 @@ fn path_without_its_caustics_plus_the_splat_is_the_path_tracer() {
         all.sort_unstable();
         assert_eq!(classes, all, "the layers do not cover every class");
         for l in &r.layers {
-            let (count, kind) = if l.classes == ["caustic"] {
+            let (count, kind) = if l.classes == ["caustic"] || l.classes == ["caustic_indirect"] {
                 (SPLAT_PHOTONS, CountKind::PhotonPaths)
             } else {
                 (PATH_SPLAT_SPP as u64, CountKind::Spp)
@@ -371,18 +371,24 @@ fn path_without_its_caustics_plus_the_splat_is_the_path_tracer() {
         assert!(px.len() >= 30, "{name}: {} pixels", px.len());
         let pt = Mean::of(full.iter().map(|img| region_mean(img, px)));
         let ps = Mean::of(split.iter().map(|img| region_mean(img, px)));
-        let splat = over_runs(&runs.path_splat, |r| region_mean(layer(r, "caustic"), px));
+        let splat = over_runs(&runs.path_splat, |r| {
+            region_mean(layer(r, "caustic"), px) + region_mean(layer(r, "caustic_indirect"), px)
+        });
+        let indirect = over_runs(&runs.path_splat, |r| {
+            region_mean(layer(r, "caustic_indirect"), px)
+        });
         let zr = z(&ps, &pt);
         eprintln!(
             "{name} ({} px): path+splat {:.4} ± {:.4}, path {:.4} ± {:.4}, z = {zr:.2}; the \
-             splat's share {:.4} = {:.1} standard errors",
+             splat's share {:.4} = {:.1} standard errors, of which caustic_indirect {:.1}",
             px.len(),
             ps.mean(),
             ps.se(),
             pt.mean(),
             pt.se(),
             splat.mean(),
-            splat.mean() / se_diff(&ps, &pt)
+            splat.mean() / se_diff(&ps, &pt),
+            indirect.mean() / se_diff(&ps, &pt)
         );
         assert!(zr.abs().max_element() < 4.0, "{name}: z = {zr}");
         if *name == "image" || *name == "caustic" {
@@ -392,6 +398,15 @@ fn path_without_its_caustics_plus_the_splat_is_the_path_tracer() {
             assert!(
                 share.min_element() > 6.0,
                 "{name}: the splat is {share} standard errors"
+            );
+        }
+        if *name == "image" {
+            // Likewise the caustics splatted onto later eye vertices alone (the path
+            // tracer's caustic_indirect paths left in, or the layer dropped).
+            let share = indirect.mean() / se_diff(&ps, &pt);
+            assert!(
+                share.min_element() > 6.0,
+                "{name}: caustic_indirect is {share} standard errors"
             );
         }
     }
@@ -416,6 +431,8 @@ fn splatting_keeps_a_bounded_number_of_chunks_alive_and_writes_no_photons() {
             spp: 1,
             splits: 2,
             threads: Some(threads),
+            pass: 0,
+            indirect: false,
         },
     ));
     let settings = SplatSettings::default();
@@ -429,11 +446,12 @@ fn splatting_keeps_a_bounded_number_of_chunks_alive_and_writes_no_photons() {
             params: &params,
             settings: &settings,
             eyes: &eyes,
+            later: None,
         };
-        let mut image = vec![DVec3::ZERO; 16 * 16];
+        let mut images = [vec![DVec3::ZERO; 16 * 16], vec![]];
         let consumed = std::sync::atomic::AtomicU64::new(0);
         let stats = splatter
-            .pass(0, &mut image, threads, &|n| {
+            .pass(0, &mut images, threads, &|n| {
                 // The first chunk waits long enough for the workers to fill the window.
                 let first = consumed.fetch_add(n, std::sync::atomic::Ordering::Relaxed) == 0;
                 std::thread::sleep(std::time::Duration::from_millis(if first {
@@ -450,7 +468,7 @@ fn splatting_keeps_a_bounded_number_of_chunks_alive_and_writes_no_photons() {
         assert_eq!(stats.emitted, params.photons);
         assert_eq!(consumed.into_inner(), params.photons);
         assert!(
-            image.iter().any(|p| p.max_element() > 0.0),
+            images[0].iter().any(|p| p.max_element() > 0.0),
             "no caustic splatted"
         );
         // The workers did run ahead of the consumer (else a missing bound would not show).
@@ -680,6 +698,7 @@ fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
             surface: 0,
             weight: Vec3::ONE,
             spacing: H,
+            first: true,
         })
         .collect();
     let eyes = EyeIndex::new(grid);
@@ -693,7 +712,7 @@ fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
         out.clear();
         let one = std::slice::from_ref(p);
         let iso = settings.isotropic_radius;
-        pipeline::splat::splat(&eyes, one, max_r, iso, &mut scratch, &mut out);
+        pipeline::splat::splat(&eyes, one, max_r, iso, 1.0, &mut scratch, &mut out);
         let kept = out.iter().map(|(_, v)| v.max_element()).sum::<f64>() * h2
             / p.flux.max_element() as f64;
         (lo, hi) = (lo.min(kept), hi.max(kept));
@@ -709,11 +728,13 @@ fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
         params: &params,
         settings: &settings,
         eyes: &eyes,
+        later: None,
     };
-    let mut e = vec![DVec3::ZERO; n * n];
+    let mut images = [vec![DVec3::ZERO; n * n], vec![]];
     splatter
-        .pass(0, &mut e, 2, &|_| {})
+        .pass(0, &mut images, 2, &|_| {})
         .unwrap_or_else(|e| panic!("{e}"));
+    let e = &images[0];
     assert!(e.iter().all(|v| v.is_finite() && v.min_element() >= 0.0));
     let splatted: DVec3 = e.iter().sum::<DVec3>() * h2;
     let rel = (splatted - flux) / flux;
@@ -768,28 +789,38 @@ fn splatting_is_bit_identical_on_one_and_two_threads() {
         ..EmitParams::default()
     };
     let settings = SplatSettings::default();
+    assert!(settings.indirect && settings.indirect_share < 1.0);
     let run = |threads| {
+        // Pass 1: the pass seed mixes in; first and later vertices, the later ones splatted
+        // with the photon roulette.
         let vertices = eye::eye_vertices(
             &scene,
             &VertexOptions {
                 spp: 4,
                 splits: 2,
                 threads: Some(threads),
+                pass: 1,
+                indirect: true,
             },
         );
-        let eyes = EyeIndex::new(vertices.clone());
+        let (first, later): (Vec<EyeVertex>, Vec<EyeVertex>) =
+            vertices.iter().partition(|v| v.first);
+        assert!(!first.is_empty() && !later.is_empty());
+        let (eyes, later) = (EyeIndex::new(first), EyeIndex::new(later));
         let splatter = Splatter {
             scene: &scene,
             params: &params,
             settings: &settings,
             eyes: &eyes,
+            later: Some(&later),
         };
-        let mut image = vec![DVec3::ZERO; 32 * 32];
+        let mut images = [vec![DVec3::ZERO; 32 * 32], vec![DVec3::ZERO; 32 * 32]];
         splatter
-            .pass(0, &mut image, threads, &|_| {})
+            .pass(1, &mut images, threads, &|_| {})
             .unwrap_or_else(|e| panic!("{e}"));
-        let bits: Vec<[u64; 3]> = image
+        let bits: Vec<[u64; 3]> = images
             .iter()
+            .flatten()
             .map(|v| v.to_array().map(f64::to_bits))
             .collect();
         (vertices, bits)

@@ -32,6 +32,9 @@ pub struct CausticPhoton {
     /// transfer (`∂x/∂u`, `∂x/∂v`, scaled by the smoothing parameter at emission).
     pub a: Vec3,
     pub b: Vec3,
+    /// Index of the path in its pass: a random number of its own for choices made later
+    /// (`math::mix64` of it), whatever the chunking.
+    pub path: u64,
 }
 
 /// The caustic photons of paths `range` (indices into `0..params.photons`) of pass `pass`,
@@ -141,6 +144,7 @@ fn trace_one(
                 flux,
                 a: rd.dodu,
                 b: rd.dodv,
+                path: index,
             });
         }
         let (wi, s) = crate::trace::scatter(&hit, bsdf, d, uc, u)?;

@@ -30,7 +30,7 @@ mod vertices;
 pub use path::{Part, PathOptions, PathTracer, Radiance};
 pub use photon::{Irradiance, MapLookup, render_final_gather, render_global_direct};
 pub use render::{RenderOptions, render};
-pub use vertices::{EyeVertex, VertexOptions, eye_vertices};
+pub use vertices::{EyeVertex, VertexOptions, eye_vertices, pass_seed};
 
 #[cfg(test)]
 mod tests;

@@ -52,11 +52,6 @@ impl Part {
     pub const fn is_caustic(self) -> bool {
         matches!(self, Part::Caustic | Part::CausticIndirect)
     }
-
-    /// True for the layer photon splatting replaces (see [`PathOptions::caustics`]).
-    pub const fn is_splatted(self) -> bool {
-        matches!(self, Part::Caustic)
-    }
 }
 
 /// One path's radiance estimate, split by [`Part`].
@@ -90,15 +85,27 @@ pub struct PathOptions {
     pub max_depth: u32,
     /// Russian roulette applies once this many bounces have been made.
     pub rr_depth: u32,
-    /// When false, exactly the paths photon splatting owns are left out: `L S+ D S* E` with
-    /// `D` the first non-delta vertex from the eye ([`Part::Caustic`] stays zero). Caustics
-    /// seen after a further diffuse bounce (`L S+ D (S* D)+ S* E`, [`Part::CausticIndirect`])
-    /// stay, since splatting onto first eye vertices cannot reach them; nothing else changes.
-    /// So `path` without caustics plus a splatted caustic layer is the whole image.
+    /// When false, the paths photon splatting owns at first eye vertices are left out:
+    /// `L S+ D S* E` with `D` the first non-delta vertex from the eye ([`Part::Caustic`]
+    /// stays zero); nothing else changes.
     pub caustics: bool,
+    /// When false, caustics seen after a further diffuse bounce are left out too:
+    /// `L S+ D (S* D)+ S* E` ([`Part::CausticIndirect`] stays zero), which splatting onto
+    /// later eye vertices owns. So `path` without both plus both splatted layers is the
+    /// whole image.
+    pub caustic_indirect: bool,
 }
 
 impl PathOptions {
+    /// Whether a path tracer with these options estimates `part`.
+    pub const fn estimates(&self, part: Part) -> bool {
+        match part {
+            Part::Caustic => self.caustics,
+            Part::CausticIndirect => self.caustic_indirect,
+            _ => true,
+        }
+    }
+
     /// Depths from the scene's `[render]` settings, caustics on.
     pub fn from_scene(scene: &Scene) -> PathOptions {
         let r = scene.render();
@@ -106,6 +113,7 @@ impl PathOptions {
             max_depth: r.max_depth,
             rr_depth: r.rr_depth,
             caustics: true,
+            caustic_indirect: true,
         }
     }
 }
@@ -119,11 +127,16 @@ pub struct PathTracer<'a> {
 
 /// Russian roulette never survives with a probability above this, so paths trapped between
 /// lossless mirrors still end (pbrt-v4 stops at the same value's complement in spirit).
-const MAX_SURVIVAL: f32 = 0.95;
+pub(crate) const MAX_SURVIVAL: f32 = 0.95;
 
 impl<'a> PathTracer<'a> {
     pub fn new(scene: &'a Scene, opts: PathOptions) -> PathTracer<'a> {
         PathTracer { scene, opts }
+    }
+
+    /// Whether this tracer estimates `part` (the two caustic switches can drop a part).
+    pub fn estimates(&self, part: Part) -> bool {
+        self.opts.estimates(part)
     }
 
     /// Radiance arriving along `-ray.d` at `ray.o`, estimated by one path whose random
@@ -156,7 +169,9 @@ impl<'a> PathTracer<'a> {
                     } else if diffuse_vertices > 1 {
                         // Specular chain from a diffuse vertex to the light: NEE's shadow
                         // rays cannot follow it, so BSDF sampling owns it (weight 1).
-                        out.add(Part::CausticIndirect, beta * le);
+                        if self.opts.caustic_indirect {
+                            out.add(Part::CausticIndirect, beta * le);
+                        }
                     } else if self.opts.caustics {
                         out.add(Part::Caustic, beta * le);
                     }

@@ -11,9 +11,12 @@ use scene::Scene;
 pub struct RenderOptions {
     /// Samples per pixel (box-filtered, jittered within the pixel).
     pub spp: u32,
-    /// Include the paths photon splatting owns (`L S+ D S* E`, the `caustic` layer); see
-    /// [`PathOptions::caustics`].
+    /// Include the paths photon splatting owns at first eye vertices (`L S+ D S* E`, the
+    /// `caustic` layer); see [`PathOptions::caustics`].
     pub caustics: bool,
+    /// Include caustics seen after a further diffuse bounce (the `caustic_indirect` layer);
+    /// see [`PathOptions::caustic_indirect`].
+    pub caustic_indirect: bool,
     /// Worker threads; `None` uses rayon's global pool. Does not change the image.
     pub threads: Option<usize>,
     /// Tile edge in pixels. Does not change the image.
@@ -27,6 +30,7 @@ impl RenderOptions {
         RenderOptions {
             spp: r.spp,
             caustics: true,
+            caustic_indirect: true,
             threads: None,
             tile: r.tile,
         }
@@ -51,6 +55,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) + Syn
         scene,
         PathOptions {
             caustics: opts.caustics,
+            caustic_indirect: opts.caustic_indirect,
             ..PathOptions::from_scene(scene)
         },
     );

@@ -261,7 +261,9 @@ fn layer(film: &Film, part: Part, spp: u32) -> film::Image {
 
 /// Full render vs `caustics = false`: every layer but `caustic` is bit-identical (caustics
 /// seen after another diffuse bounce stay), `caustic` is exactly zero, and it sits in the
-/// sphere's shadow cone on the floor, brightest at the ball's focus.
+/// sphere's shadow cone on the floor, brightest at the ball's focus. With `caustic_indirect`
+/// off as well, `caustic_indirect` is exactly zero too (it was not before) and the other
+/// layers still do not move.
 ///
 /// Not asserted: exact zero outside the cone. Fresnel reflection off the sphere's outside is
 /// an `L S D` path to *every* floor point (a convex mirror shows the light to all of them),
@@ -273,6 +275,7 @@ fn caustic_switch_removes_exactly_the_caustic_layers() {
     let opts = RenderOptions {
         spp,
         caustics: true,
+        caustic_indirect: true,
         threads: None,
         tile: 8,
     };
@@ -309,6 +312,30 @@ fn caustic_switch_removes_exactly_the_caustic_layers() {
         );
         assert!((0..32).all(|y| (0..32).all(|x| l.sum(x, y) == [0.0; 3])));
     }
+    let neither = render(
+        &scene,
+        &RenderOptions {
+            caustics: false,
+            caustic_indirect: false,
+            ..opts
+        },
+        &|_| {},
+    );
+    for part in [Part::Emitted, Part::Direct, Part::Indirect, Part::Caustic] {
+        assert_eq!(
+            without.layer(part.name()),
+            neither.layer(part.name()),
+            "{} changed with the caustic_indirect switch",
+            part.name()
+        );
+    }
+    let zero = |f: &Film| {
+        layer(f, Part::CausticIndirect, spp)
+            .data
+            .iter()
+            .all(|p| *p == [0.0; 3])
+    };
+    assert!(!zero(&full) && zero(&neither));
 
     let caustic = layer(&full, Part::Caustic, spp);
     let (mut inside, mut outside, mut focus) =
@@ -373,6 +400,7 @@ fn films_are_bit_identical_for_any_thread_count_and_tile_size() {
         let opts = RenderOptions {
             spp,
             caustics: true,
+            caustic_indirect: true,
             threads: Some(threads),
             tile,
         };
@@ -405,6 +433,7 @@ fn cornell_layers_are_finite_and_non_negative() {
             &RenderOptions {
                 spp,
                 caustics: true,
+                caustic_indirect: true,
                 threads: None,
                 tile: 16,
             },
@@ -561,6 +590,7 @@ fn global_map_through_glass_is_not_speckled_at_one_sample() {
     let opts = RenderOptions {
         spp: 1,
         caustics: true,
+        caustic_indirect: true,
         threads: None,
         tile: 8,
     };

@@ -247,26 +247,19 @@ fn peak_rss_mib() -> Option<f64> {
 /// the peak memory before and after splatting ten times more photons (flat if no photon is
 /// kept).
 pub fn splat(path: &Path, photons: u64, runs: usize) -> Result<(), String> {
-    use crate::splat::{EyeIndex, Splatter};
+    use crate::splat::{Splatter, eye_indexes};
     let s = scene::Scene::load(path).map_err(|e| e.to_string())?;
     let settings = crate::Settings::new(&s, &crate::Overrides::default())?;
     let sp = settings.estimate.splat;
     let mut params = settings.emit.clone();
     params.photons = photons;
     let t0 = Instant::now();
-    let vertices = eye::eye_vertices(
-        &s,
-        &eye::VertexOptions {
-            spp: settings.estimate.spp,
-            splits: sp.splits,
-            threads: None,
-        },
-    );
-    let eyes = EyeIndex::new(vertices);
+    let (eyes, later) = eye_indexes(&s, &sp, settings.estimate.spp, 0, None);
     println!(
-        "scene {}, {} eye vertices in {:.3} s, {photons} caustic photon paths per run, median of {runs}",
+        "scene {}, {} first and {} later eye vertices in {:.3} s, {photons} caustic photon paths per run, median of {runs}",
         path.display(),
         eyes.len(),
+        later.as_ref().map_or(0, |l| l.len()),
         t0.elapsed().as_secs_f64()
     );
     let (w, h) = (s.camera.width as usize, s.camera.height as usize);
@@ -275,12 +268,16 @@ pub fn splat(path: &Path, photons: u64, runs: usize) -> Result<(), String> {
         params: &params,
         settings: &sp,
         eyes: &eyes,
+        later: later.as_ref(),
     };
     for threads in [1usize, 2] {
         let mut rates = Vec::new();
         for run in 0..runs.max(1) {
-            let mut image = vec![glam::DVec3::ZERO; w * h];
-            let stats = splatter.pass(run as u64, &mut image, threads, &|_| {})?;
+            let mut images = [
+                vec![glam::DVec3::ZERO; w * h],
+                vec![glam::DVec3::ZERO; w * h],
+            ];
+            let stats = splatter.pass(run as u64, &mut images, threads, &|_| {})?;
             rates.push(photons as f64 / stats.seconds);
         }
         rates.sort_by(f64::total_cmp);
@@ -292,14 +289,18 @@ pub fn splat(path: &Path, photons: u64, runs: usize) -> Result<(), String> {
     let before = peak_rss_mib();
     let mut many = params.clone();
     many.photons = photons * 10;
-    let mut image = vec![glam::DVec3::ZERO; w * h];
+    let mut images = [
+        vec![glam::DVec3::ZERO; w * h],
+        vec![glam::DVec3::ZERO; w * h],
+    ];
     Splatter {
         scene: &s,
         params: &many,
         settings: &sp,
         eyes: &eyes,
+        later: later.as_ref(),
     }
-    .pass(0, &mut image, 2, &|_| {})?;
+    .pass(0, &mut images, 2, &|_| {})?;
     match (before, peak_rss_mib()) {
         (Some(a), Some(b)) => println!(
             "peak memory: {a:.1} MiB after {photons} photons per pass, {b:.1} MiB after {} in one pass",

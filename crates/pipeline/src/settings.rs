@@ -43,9 +43,23 @@ pub struct SplatSettings {
     /// Isotropic splatting with this fixed radius in scene units instead of the photon
     /// differentials' footprints (0: differentials). For comparisons.
     pub isotropic_radius: f32,
-    /// Photon passes: pass `j` traces `photons` new paths from streams `(seed, j, i)`; the
-    /// layer is their mean. A run stopped by a time budget records the passes it made.
+    /// Photon passes: pass `j` traces `photons` new paths from streams `(seed, j, i)` onto
+    /// new eye vertices; the layers are their mean. A run stopped by a time budget records
+    /// the passes it made.
     pub passes: u32,
+    /// Also splat onto the later diffuse vertices of the eye paths: caustics seen through a
+    /// diffuse bounce (`caustic_indirect`), the path tracer's noisiest paths. When on, the
+    /// path tracer of `path+splat` (and `--no-caustics`) leaves those paths out too.
+    pub indirect: bool,
+    /// Radius of the disc in which a photon reaches later eye vertices, in scene units (0:
+    /// `max_radius`). A diffuse bounce blurs what it sees, so detail finer than this is not
+    /// missed; the disc keeps the vertex count a splat meets, and its noise, steady.
+    pub indirect_radius: f32,
+    /// The share of photons splatted onto later eye vertices (their flux divided by it): a
+    /// later vertex's noise is mostly where its eye path went, not which photons landed near
+    /// it, and each photon meets many later vertices, so fewer photons cost less for the
+    /// same error.
+    pub indirect_share: f32,
 }
 
 impl Default for SplatSettings {
@@ -57,6 +71,9 @@ impl Default for SplatSettings {
             splits: 2,
             isotropic_radius: 0.0,
             passes: 1,
+            indirect: true,
+            indirect_radius: 0.0,
+            indirect_share: 0.125,
         }
     }
 }

@@ -1,8 +1,11 @@
-//! Photon differential splatting onto eye vertices (Frisvad et al. 2014): the eye vertices
-//! (E S* D) are indexed once; caustic photons with differentials (L S+ D, `emit`) are traced
-//! in chunks on the pipeline's workers, and each photon adds to every eye vertex inside its
-//! footprint `Φ_p K(|M (y - x_p)|) |det M|` (`density::splat`), accepting only vertices on
-//! the same surface and side. No photon is stored in a map or a file: a chunk's photons live
+//! Photon differential splatting onto eye vertices (Frisvad et al. 2014): a pass's eye
+//! vertices (E S* D, and the later diffuse vertices E S* D (S* D)+ when `indirect` is on) are
+//! indexed once; caustic photons with differentials (L S+ D, `emit`) are traced in chunks on
+//! the pipeline's workers, and each photon adds to every first eye vertex inside its
+//! footprint `Φ_p K(|M (y - x_p)|) |det M|` (`density::splat`), and to every later eye vertex
+//! inside a disc of `indirect_radius` (a diffuse bounce blurs what it sees: the argument
+//! behind final gathering, Jensen 1996, "Global illumination using photon maps"), accepting only vertices on the same surface
+//! and side. No photon is stored in a map or a file: a chunk's photons live
 //! only while its worker splats them, and what crosses the channel to the ordering stage is
 //! the chunk's pixel contributions, added in chunk order (so the image is the same for any
 //! thread count).
@@ -12,7 +15,7 @@ use crate::settings::SplatSettings;
 use density::splat::Footprint;
 use density::{Index, IndexKind, Neighbor};
 use emit::{CausticPhoton, EmitParams};
-use eye::EyeVertex;
+use eye::{EyeVertex, VertexOptions};
 use glam::{DVec3, Vec3};
 use scene::Scene;
 
@@ -21,6 +24,9 @@ use scene::Scene;
 const TOPO_EPS: f32 = 0.1;
 /// Smallest cosine between a vertex's normal and the photon's: same surface, same side.
 const SAME_SIDE_COS: f32 = 0.9;
+
+/// Decorrelates the photon roulette of [`splat`] from other uses of the path index.
+const SHARE_SALT: u64 = 0x7368_6172_6520_7370;
 
 /// Eye vertices under a kd-tree.
 pub struct EyeIndex {
@@ -50,6 +56,32 @@ impl EyeIndex {
     }
 }
 
+/// The eye vertices of pass `pass` (`spp` pixel samples each), indexed: the first diffuse
+/// vertices, and the later ones when the settings ask for them.
+pub fn eye_indexes(
+    scene: &Scene,
+    s: &SplatSettings,
+    spp: u32,
+    pass: u64,
+    threads: Option<usize>,
+) -> (EyeIndex, Option<EyeIndex>) {
+    let all = eye::eye_vertices(
+        scene,
+        &VertexOptions {
+            spp,
+            splits: s.splits,
+            threads,
+            pass,
+            indirect: s.indirect,
+        },
+    );
+    if !s.indirect {
+        return (EyeIndex::new(all), None);
+    }
+    let (first, later): (Vec<EyeVertex>, Vec<EyeVertex>) = all.into_iter().partition(|v| v.first);
+    (EyeIndex::new(first), Some(EyeIndex::new(later)))
+}
+
 /// Scratch space of one worker.
 #[derive(Default)]
 pub struct Scratch {
@@ -77,18 +109,31 @@ pub fn footprint(
 
 /// Adds what `photons` deposit at the eye vertices to `out`, as `(pixel, radiance)` pairs
 /// in photon order, then vertex order. `isotropic > 0` replaces every footprint by a disc of
-/// that radius (the fixed-radius splatting that differentials improve on).
+/// that radius (the fixed-radius splatting that differentials improve on). `share < 1`
+/// splats each photon with that probability (a pure function of its path index), its flux
+/// divided by it: Russian roulette on photons, unbiased, for vertices whose noise is not the
+/// photons' (see [`SplatSettings::indirect_share`]).
 pub fn splat(
     eyes: &EyeIndex,
     photons: &[CausticPhoton],
     max_radius: f32,
     isotropic: f32,
+    share: f64,
     scratch: &mut Scratch,
     out: &mut Vec<(u32, DVec3)>,
 ) {
     for p in photons {
         if !p.flux.is_finite() {
             continue;
+        }
+        let mut flux = p.flux.as_dvec3();
+        if share < 1.0 {
+            // 53 random bits of the path index.
+            let u = (math::mix64(p.path ^ SHARE_SALT) >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
+            if u >= share {
+                continue;
+            }
+            flux /= share;
         }
         let f = if isotropic > 0.0 {
             let frame = math::Frame::from_z(p.normal);
@@ -117,10 +162,20 @@ pub fn splat(
             }
             let w = f.weight(v.p);
             if w > 0.0 {
-                let e = p.flux.as_dvec3() * w;
+                let e = flux * w;
                 out.push((v.pixel, v.weight.as_dvec3() * e));
             }
         }
+    }
+}
+
+/// The radius of the disc in which photons reach later eye vertices: the setting, or the
+/// largest footprint semi-axis.
+pub fn indirect_radius(scene: &Scene, s: &SplatSettings) -> f32 {
+    if s.indirect_radius > 0.0 {
+        s.indirect_radius
+    } else {
+        max_radius(scene, s)
     }
 }
 
@@ -139,49 +194,70 @@ pub fn max_radius(scene: &Scene, s: &SplatSettings) -> f32 {
 }
 
 /// What a splatting pass needs: the scene, its caustic paths' parameters (`params.photons`
-/// per pass, `params.max_depth`), the splat settings and the indexed eye vertices.
+/// per pass, `params.max_depth`), the splat settings and the indexed eye vertices (first, and
+/// later ones if any).
 pub struct Splatter<'a> {
     pub scene: &'a Scene,
     pub params: &'a EmitParams,
     pub settings: &'a SplatSettings,
     pub eyes: &'a EyeIndex,
+    pub later: Option<&'a EyeIndex>,
 }
 
+/// One chunk's photon count and its `(pixel, radiance)` pairs at first and at later vertices.
+type Chunk = (u64, [Vec<(u32, DVec3)>; 2]);
+
 impl Splatter<'_> {
-    /// One pass of the caustic layer: the caustic paths of pass `pass` splatted onto the eye
-    /// vertices and added to `image` (one f64 RGB sum per pixel) in chunk order.
+    /// One pass of the caustic layers: the caustic paths of pass `pass` splatted onto the eye
+    /// vertices and added to `images` (one f64 RGB sum per pixel; `[0]` at first vertices,
+    /// `[1]` at later ones) in chunk order.
     pub fn pass(
         &self,
         pass: u64,
-        image: &mut [DVec3],
+        images: &mut [Vec<DVec3>; 2],
         threads: usize,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<TraceStats, String> {
         let (scene, params, s, eyes) = (self.scene, self.params, self.settings, self.eyes);
         let max_r = max_radius(scene, s);
-        let work = |range: std::ops::Range<u64>| -> (u64, Vec<(u32, DVec3)>) {
+        let indirect_r = indirect_radius(scene, s);
+        let work = |range: std::ops::Range<u64>| -> Chunk {
             let n = range.end - range.start;
             let photons = emit::trace_caustics(scene, params, s.scale, pass, range);
-            let mut out = Vec::new();
+            let mut out = [Vec::new(), Vec::new()];
             let mut scratch = Scratch::default();
             splat(
                 eyes,
                 &photons,
                 max_r,
                 s.isotropic_radius,
+                1.0,
                 &mut scratch,
-                &mut out,
+                &mut out[0],
             );
+            if let Some(later) = self.later {
+                splat(
+                    later,
+                    &photons,
+                    indirect_r,
+                    indirect_r,
+                    s.indirect_share.clamp(0.0, 1.0) as f64,
+                    &mut scratch,
+                    &mut out[1],
+                );
+            }
             (n, out)
         };
         flow::run_chunks(
             params.photons,
             &PipelineOptions::new(threads),
             &work,
-            &mut |(n, contributions): (u64, Vec<(u32, DVec3)>)| {
-                for (pixel, v) in contributions {
-                    if v.is_finite() {
-                        image[pixel as usize] += v;
+            &mut |(n, contributions): Chunk| {
+                for (image, contributions) in images.iter_mut().zip(contributions) {
+                    for (pixel, v) in contributions {
+                        if v.is_finite() {
+                            image[pixel as usize] += v;
+                        }
                     }
                 }
                 progress(n);

@@ -58,6 +58,7 @@ impl Run<'_> {
         eye::RenderOptions {
             spp,
             caustics: true,
+            caustic_indirect: true,
             threads: self.threads,
             tile: self.settings.render.tile,
         }

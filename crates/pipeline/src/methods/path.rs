@@ -1,5 +1,6 @@
 //! `path`: the independent path-traced reference (`eye::render`), `render.spp` samples per
-//! pixel, caustic paths left out when `render.caustics` is off.
+//! pixel. With `render.caustics` off it leaves out the paths splatting owns: the `caustic`
+//! layer, and `caustic_indirect` too when `[estimate.splat] indirect` is on.
 
 use super::{CountKind, Layer, LayerSpec, Rendered, Run};
 use eye::Part;
@@ -8,16 +9,22 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     let r = &run.settings.render;
     let opts = eye::RenderOptions {
         caustics: r.caustics,
+        caustic_indirect: r.caustics || !run.settings.estimate.splat.indirect,
         ..run.render_options(r.spp)
+    };
+    let path_opts = eye::PathOptions {
+        caustics: opts.caustics,
+        caustic_indirect: opts.caustic_indirect,
+        ..eye::PathOptions::from_scene(run.scene)
     };
     let t0 = std::time::Instant::now();
     let film = eye::render(run.scene, &opts, progress);
     let seconds = t0.elapsed().as_secs_f64();
-    // Each path-traced layer is one class; with caustics off the `caustic` layer estimates
-    // nothing and is left out, so a splatted caustic layer can take its place.
+    // Each path-traced layer is one class; a layer the caustic switches empty is left out,
+    // so a splatted layer can take its place.
     let parts: Vec<Part> = Part::ALL
         .into_iter()
-        .filter(|p| r.caustics || !p.is_splatted())
+        .filter(|&p| path_opts.estimates(p))
         .collect();
     let specs: Vec<LayerSpec> = parts
         .iter()
@@ -40,6 +47,7 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     for (k, v) in [
         ("spp", serde_json::json!(r.spp)),
         ("caustics", r.caustics.into()),
+        ("caustic_indirect", opts.caustic_indirect.into()),
         ("max_depth", r.max_depth.into()),
         ("rr_depth", r.rr_depth.into()),
         ("samples", samples.into()),

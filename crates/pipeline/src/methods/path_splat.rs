@@ -1,6 +1,7 @@
 //! `path+splat`: the path tracer without the paths splatting owns (`render.caustics` off:
-//! exactly `L S+ D S* E` with D the first diffuse vertex from the eye), plus those paths by
-//! photon differential splatting. The layers partition path space (`eye::Part`), so nothing
+//! exactly `L S+ D S* E` with D the first diffuse vertex from the eye, and with `[estimate.
+//! splat] indirect` also the caustics seen through further diffuse bounces), plus those
+//! paths by photon differential splatting. The layers partition path space (`eye::Part`), so nothing
 //! is counted twice and nothing is missed; they are composited as `composite` would.
 
 use super::{Rendered, Run};
@@ -14,8 +15,8 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     };
     let mut r = super::path::render(&path_run, progress)?;
     // The splat's progress counts photons, not samples: it reports through its own line.
-    let (caustic, info, passes) = super::caustic_splat::caustic_layer(run, &|_| {})?;
-    r.layers.push(caustic);
+    let (caustic, info, passes) = super::caustic_splat::caustic_layers(run, &|_| {})?;
+    r.layers.extend(caustic);
     r.info.extend(info);
     r.passes = Some(passes);
     Ok(r)
