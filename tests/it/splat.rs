@@ -432,7 +432,6 @@ fn splatting_keeps_a_bounded_number_of_chunks_alive_and_writes_no_photons() {
             splits: 2,
             threads: Some(threads),
             pass: 0,
-            indirect: false,
         },
     ));
     let settings = SplatSettings::default();
@@ -446,9 +445,8 @@ fn splatting_keeps_a_bounded_number_of_chunks_alive_and_writes_no_photons() {
             params: &params,
             settings: &settings,
             eyes: &eyes,
-            later: None,
         };
-        let mut images = [vec![DVec3::ZERO; 16 * 16], vec![]];
+        let mut images = [vec![DVec3::ZERO; 16 * 16], vec![DVec3::ZERO; 16 * 16]];
         let consumed = std::sync::atomic::AtomicU64::new(0);
         let stats = splatter
             .pass(0, &mut images, threads, &|n| {
@@ -631,7 +629,7 @@ fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
         photons,
         ..EmitParams::default()
     };
-    let ps: Vec<CausticPhoton> = emit::trace_caustics(&scene, &params, 1.0, 0, 0..photons);
+    let ps: Vec<CausticPhoton> = emit::trace_caustics(&scene, &params, 1.0, 0, 0..photons, false);
     let plan = Plan::for_scene(&scene, &params).unwrap_or_else(|e| panic!("{e}"));
     let map = emit::trace_range(&scene, &params, &plan, 0..photons);
     let flux: DVec3 = ps.iter().map(|p| p.flux.as_dvec3()).sum();
@@ -698,7 +696,6 @@ fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
             surface: 0,
             weight: Vec3::ONE,
             spacing: H,
-            first: true,
         })
         .collect();
     let eyes = EyeIndex::new(grid);
@@ -712,7 +709,7 @@ fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
         out.clear();
         let one = std::slice::from_ref(p);
         let iso = settings.isotropic_radius;
-        pipeline::splat::splat(&eyes, one, max_r, iso, 1.0, &mut scratch, &mut out);
+        pipeline::splat::splat(&eyes, one, max_r, iso, &mut scratch, &mut out);
         let kept = out.iter().map(|(_, v)| v.max_element()).sum::<f64>() * h2
             / p.flux.max_element() as f64;
         (lo, hi) = (lo.min(kept), hi.max(kept));
@@ -728,14 +725,18 @@ fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
         params: &params,
         settings: &settings,
         eyes: &eyes,
-        later: None,
     };
-    let mut images = [vec![DVec3::ZERO; n * n], vec![]];
+    let mut images = [vec![DVec3::ZERO; n * n], vec![DVec3::ZERO; n * n]];
     splatter
         .pass(0, &mut images, 2, &|_| {})
         .unwrap_or_else(|e| panic!("{e}"));
     let e = &images[0];
-    assert!(e.iter().all(|v| v.is_finite() && v.min_element() >= 0.0));
+    assert!(
+        images
+            .iter()
+            .flatten()
+            .all(|v| v.is_finite() && v.min_element() >= 0.0)
+    );
     let splatted: DVec3 = e.iter().sum::<DVec3>() * h2;
     let rel = (splatted - flux) / flux;
     eprintln!("hostile: splatted {splatted:.5} of {flux:.5} ({rel:+.5})");
@@ -789,10 +790,9 @@ fn splatting_is_bit_identical_on_one_and_two_threads() {
         ..EmitParams::default()
     };
     let settings = SplatSettings::default();
-    assert!(settings.indirect && settings.indirect_share < 1.0);
+    assert!(settings.indirect);
     let run = |threads| {
-        // Pass 1: the pass seed mixes in; first and later vertices, the later ones splatted
-        // with the photon roulette.
+        // Pass 1: the pass seed mixes in; caustic paths followed past their first diffuse hit.
         let vertices = eye::eye_vertices(
             &scene,
             &VertexOptions {
@@ -800,24 +800,20 @@ fn splatting_is_bit_identical_on_one_and_two_threads() {
                 splits: 2,
                 threads: Some(threads),
                 pass: 1,
-                indirect: true,
             },
         );
-        let (first, later): (Vec<EyeVertex>, Vec<EyeVertex>) =
-            vertices.iter().partition(|v| v.first);
-        assert!(!first.is_empty() && !later.is_empty());
-        let (eyes, later) = (EyeIndex::new(first), EyeIndex::new(later));
+        let eyes = EyeIndex::new(vertices.clone());
         let splatter = Splatter {
             scene: &scene,
             params: &params,
             settings: &settings,
             eyes: &eyes,
-            later: Some(&later),
         };
         let mut images = [vec![DVec3::ZERO; 32 * 32], vec![DVec3::ZERO; 32 * 32]];
         splatter
             .pass(1, &mut images, threads, &|_| {})
             .unwrap_or_else(|e| panic!("{e}"));
+        assert!(images[1].iter().any(|v| v.max_element() > 0.0));
         let bits: Vec<[u64; 3]> = images
             .iter()
             .flatten()

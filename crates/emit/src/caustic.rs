@@ -4,6 +4,9 @@
 //! mirror, metal and glass to its first diffuse hit after at least one specular bounce
 //! (L S+ D), where the transferred positional derivatives are the two axes of the photon's
 //! footprint. Paths whose first hit is diffuse (direct light) carry no caustic and end there.
+//! On request a caustic path goes on past its first diffuse hit, by cosine sampling and the
+//! photon tracer's Russian roulette, and is a caustic photon again at every later diffuse hit
+//! (L S+ D (S* D)+: caustics that light other surfaces), without differentials.
 //!
 //! Photon `i` draws the same random numbers as [`crate::trace_range`]'s photon `i` (5 to
 //! emit, 3 per hit), so a splatted caustic photon and the caustic map's photon of the same
@@ -35,10 +38,16 @@ pub struct CausticPhoton {
     /// Index of the path in its pass: a random number of its own for choices made later
     /// (`math::mix64` of it), whatever the chunking.
     pub path: u64,
+    /// Diffuse hits of the path so far, this one included: 1 at the first (L S+ D), where
+    /// the footprint is `a`, `b`; more after further diffuse bounces (L S+ D (S* D)+), where
+    /// `a` and `b` are zero.
+    pub diffuse: u32,
 }
 
 /// The caustic photons of paths `range` (indices into `0..params.photons`) of pass `pass`,
-/// in index order; `scale` is the smoothing parameter `s` of [`emit_diff`]. Photon `i` of
+/// in index order (each path's hits in order); `indirect` follows each path on past its
+/// first diffuse hit (cosine sampling and the photon tracer's Russian roulette), adding a
+/// photon at every later diffuse hit. `scale` is the smoothing parameter `s` of [`emit_diff`]. Photon `i` of
 /// pass `j` draws from the stream `(seed, j, i)` alone ([`pass_stream`]), so the result is a
 /// pure function of the scene's seed, the pass and the indices, like [`crate::trace_range`].
 pub fn trace_caustics(
@@ -47,6 +56,7 @@ pub fn trace_caustics(
     scale: f32,
     pass: u64,
     range: Range<u64>,
+    indirect: bool,
 ) -> Vec<CausticPhoton> {
     let mut out = Vec::new();
     if params.max_depth == 0 {
@@ -54,9 +64,7 @@ pub fn trace_caustics(
     }
     let stream = pass_stream(scene.seed(), pass);
     for i in range {
-        if let Some(p) = trace_one(scene, params, scale, stream, i) {
-            out.push(p);
-        }
+        trace_one(scene, params, scale, stream, i, indirect, &mut out);
     }
     out
 }
@@ -104,7 +112,9 @@ fn trace_one(
     scale: f32,
     stream: u64,
     index: u64,
-) -> Option<CausticPhoton> {
+    indirect: bool,
+    out: &mut Vec<CausticPhoton>,
+) {
     let mut rng = Rng::for_index(stream, index);
     // The layout of `trace_range`: 5 numbers to emit, then 3 per hit, used or not.
     let (u_light, u_pos, u_dir) = (rng.uniform(), rng.uniform2(), rng.uniform2());
@@ -118,52 +128,84 @@ fn trace_one(
     );
     let mut flux = e.flux.as_vec3();
     let mut ray = e.ray;
-    // Every hit before the diffuse one is specular, so the hit index counts them.
-    for specular_bounces in 0..params.max_depth {
+    let mut specular_bounces = 0u32;
+    let mut diffuse = 0u32;
+    for _ in 0..params.max_depth {
         if !flux.cmpgt(Vec3::ZERO).any() {
-            return None;
+            return;
         }
-        let hit = scene.geometry.intersect(&ray)?;
+        let Some(hit) = scene.geometry.intersect(&ray) else {
+            return;
+        };
         let (uc, u) = (rng.uniform(), rng.uniform2());
-        let bsdf = scene.bsdf(hit.material)?;
+        let Some(bsdf) = scene.bsdf(hit.material) else {
+            return;
+        };
         let d = ray.d.normalize();
         let ng = hit.point.n;
-        // Move the differentials onto the surface's plane: the footprint on this surface.
-        rd.o = ray.o;
-        rd.d = d;
-        rd = transfer(&rd, hit.t, ng);
-        if !rd.is_finite() {
-            return None;
+        if diffuse == 0 {
+            // Move the differentials onto the surface's plane: the footprint on this surface.
+            rd.o = ray.o;
+            rd.d = d;
+            rd = transfer(&rd, hit.t, ng);
+            if !rd.is_finite() {
+                return;
+            }
         }
         if !bsdf.is_delta() {
-            // First diffuse hit: a caustic photon if the path so far is L S+.
-            return (specular_bounces > 0).then(|| CausticPhoton {
+            // A diffuse hit: a caustic photon if the path so far is L S+ (D S*)*; the
+            // differentials mean something only at the first.
+            if specular_bounces == 0 && diffuse == 0 {
+                return;
+            }
+            diffuse += 1;
+            let first = diffuse == 1;
+            out.push(CausticPhoton {
                 position: hit.point.p,
                 normal: if d.dot(ng) < 0.0 { ng } else { -ng },
                 surface: surface_id(hit.prim),
                 flux,
-                a: rd.dodu,
-                b: rd.dodv,
+                a: if first { rd.dodu } else { Vec3::ZERO },
+                b: if first { rd.dodv } else { Vec3::ZERO },
                 path: index,
+                diffuse,
             });
-        }
-        let (wi, s) = crate::trace::scatter(&hit, bsdf, d, uc, u)?;
-        flux *= s.weight();
-        let (dndu, dndv) = normal_derivatives(scene, &hit, rd.dodu, rd.dodv);
-        let n = hit.ns;
-        rd = match (s.is_transmission(), bsdf) {
-            (true, Bsdf::Dielectric(g)) => {
-                // Entering when the photon arrives on the shading normal's side (the
-                // dielectric's own convention).
-                let eta = if d.dot(n) < 0.0 { 1.0 / g.eta } else { g.eta };
-                refract_diff(&rd, n, dndu, dndv, eta)
-                    .unwrap_or_else(|| reflect_diff(&rd, n, dndu, dndv))
+            let (true, Bsdf::Lambertian(l)) = (indirect, bsdf) else {
+                return;
+            };
+            // The photon tracer's Russian roulette at a diffuse bounce (`trace_range`).
+            let survive = (l.albedo * flux).max_element() / flux.max_element();
+            if uc >= survive {
+                return;
             }
-            _ => reflect_diff(&rd, n, dndu, dndv),
+            flux = flux * l.albedo / survive;
+            let Some((wi, _)) = crate::trace::scatter(&hit, bsdf, d, uc, u) else {
+                return;
+            };
+            ray = hit.point.spawn_ray(wi);
+            continue;
+        }
+        let Some((wi, s)) = crate::trace::scatter(&hit, bsdf, d, uc, u) else {
+            return;
         };
+        flux *= s.weight();
+        specular_bounces += 1;
+        if diffuse == 0 {
+            let (dndu, dndv) = normal_derivatives(scene, &hit, rd.dodu, rd.dodv);
+            let n = hit.ns;
+            rd = match (s.is_transmission(), bsdf) {
+                (true, Bsdf::Dielectric(g)) => {
+                    // Entering when the photon arrives on the shading normal's side (the
+                    // dielectric's own convention).
+                    let eta = if d.dot(n) < 0.0 { 1.0 / g.eta } else { g.eta };
+                    refract_diff(&rd, n, dndu, dndv, eta)
+                        .unwrap_or_else(|| reflect_diff(&rd, n, dndu, dndv))
+                }
+                _ => reflect_diff(&rd, n, dndu, dndv),
+            };
+            // The sampled direction is the one traced; the differentials follow it.
+            rd.d = wi;
+        }
         ray = hit.point.spawn_ray(wi);
-        // The sampled direction is the one traced; the differentials follow it.
-        rd.d = wi;
     }
-    None
 }

@@ -665,7 +665,7 @@ fn splatted_caustic_photons_are_the_caustic_maps_photons_with_footprints() {
     let scene = load("cornell-spheres/analytic.toml");
     let p = params(20_000);
     let t = trace_range(&scene, &p, &plan(&scene, &p), 0..p.photons);
-    let c = crate::trace_caustics(&scene, &p, 1.0, 0, 0..p.photons);
+    let c = crate::trace_caustics(&scene, &p, 1.0, 0, 0..p.photons, false);
     let map = &t[MapKind::Caustic];
     assert!(map.len() > 100, "{} caustic photons", map.len());
     assert_eq!(c.len(), map.len());
@@ -683,13 +683,36 @@ fn splatted_caustic_photons_are_the_caustic_maps_photons_with_footprints() {
         }
     }
     // Another pass draws other photons; a range of a pass is that pass's photons.
-    let next = crate::trace_caustics(&scene, &p, 1.0, 1, 0..p.photons);
+    let next = crate::trace_caustics(&scene, &p, 1.0, 1, 0..p.photons, false);
     assert!(next.len() > 100 && next[..10] != c[..10]);
     assert_eq!(
-        crate::trace_caustics(&scene, &p, 1.0, 1, 5_000..p.photons),
+        crate::trace_caustics(&scene, &p, 1.0, 1, 5_000..p.photons, false),
         next.iter()
             .copied()
-            .filter(|x| !crate::trace_caustics(&scene, &p, 1.0, 1, 0..5_000).contains(x))
+            .filter(|x| !crate::trace_caustics(&scene, &p, 1.0, 1, 0..5_000, false).contains(x))
             .collect::<Vec<_>>()
     );
+    // Followed past the first diffuse hit, the same paths go on as the photon tracer's do
+    // (same numbers, same Russian roulette): the first hits are the photons above, every
+    // later hit is one of the global set's photons, the same point with the same flux.
+    let all = crate::trace_caustics(&scene, &p, 1.0, 0, 0..p.photons, true);
+    let first: Vec<_> = all.iter().filter(|x| x.diffuse == 1).copied().collect();
+    assert_eq!(first, c);
+    let key = |pos: glam::Vec3, flux: glam::Vec3| {
+        (
+            pos.to_array().map(f32::to_bits),
+            flux.to_array().map(f32::to_bits),
+        )
+    };
+    let global: std::collections::HashSet<_> = t[MapKind::Global]
+        .iter()
+        .map(|g| key(g.position(), g.power()))
+        .collect();
+    let later: Vec<_> = all.iter().filter(|x| x.diffuse > 1).collect();
+    assert!(later.len() > 100, "{} later photons", later.len());
+    for x in &later {
+        assert!(global.contains(&key(x.position, x.flux)), "{x:?}");
+        assert_eq!((x.a, x.b), (glam::Vec3::ZERO, glam::Vec3::ZERO));
+    }
+    assert!(later.iter().any(|x| x.diffuse > 2));
 }

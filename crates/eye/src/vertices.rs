@@ -1,11 +1,9 @@
 //! Eye vertices: where camera paths first meet a diffuse surface after any number of specular
 //! bounces (E S* D), the points at which photon splatting (and SPPM's visible points)
-//! estimate radiance, and optionally the later diffuse vertices of the same paths
-//! (E S* D (S* D)+), continued by cosine sampling and Russian roulette like the path tracer,
-//! where splatting estimates the caustics seen through a diffuse bounce. Through glass both
-//! reflection and refraction are followed, weighted by Fresnel, for the first few dielectric
-//! hits (the course framework's two splits), then one of them is chosen with Fresnel
-//! probability (Russian roulette), so 1-spp images through the glass sphere are not speckled.
+//! estimate radiance. Through glass both reflection and refraction are followed, weighted by
+//! Fresnel, for the first few dielectric hits (the course framework's two splits), then one
+//! of them is chosen with Fresnel probability (Russian roulette), so 1-spp images through the
+//! glass sphere are not speckled.
 
 use bsdf::{Bsdf, TransportMode};
 use geom::{Hit, Ray};
@@ -14,7 +12,7 @@ use math::{Frame, Rng, mix64};
 use rayon::prelude::*;
 use scene::{Scene, sides_agree, surface_id};
 
-/// A diffuse vertex of one eye path.
+/// The first diffuse vertex of one eye path.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EyeVertex {
     /// Pixel index `y * width + x`.
@@ -29,10 +27,8 @@ pub struct EyeVertex {
     pub weight: Vec3,
     /// The distance between neighbouring vertices here: the pixel's footprint on the
     /// surface, `distance × pixel angle / |cos θ|`, over `sqrt(spp)`. Splats thinner than
-    /// this would fall between vertices. Meaningful for first vertices only.
+    /// this would fall between vertices.
     pub spacing: f32,
-    /// The path's first diffuse vertex (else a later one, after a diffuse bounce).
-    pub first: bool,
 }
 
 /// How eye vertices are made.
@@ -45,13 +41,11 @@ pub struct VertexOptions {
     pub threads: Option<usize>,
     /// Which pass of a progressive method: each pass draws new pixel samples.
     pub pass: u64,
-    /// Also the later diffuse vertices (paths continued past the first one).
-    pub indirect: bool,
 }
 
 /// The random stream seed of pass `pass`'s eye vertices: pass 0 uses the scene's seed, as
-/// every eye pass does (its first vertices are the photon-map passes'), later passes a
-/// SplitMix64 mix of the pass number (Steele et al. 2014).
+/// every eye pass does (its vertices are the photon-map passes' first vertices), later passes
+/// a SplitMix64 mix of the pass number (Steele et al. 2014).
 pub fn pass_seed(seed: u64, pass: u64) -> u64 {
     if pass == 0 {
         seed
@@ -60,10 +54,10 @@ pub fn pass_seed(seed: u64, pass: u64) -> u64 {
     }
 }
 
-/// The eye vertices of every pixel sample, in pixel order, then sample order, then walk order
-/// (depth first, reflection before refraction). Pixel sample `s` of pixel `p` draws from
-/// `Rng::for_index(pass_seed(seed, pass), p * spp + s)` after two numbers for its jitter, like
-/// every eye pass, so the list is the same for any thread count.
+/// The eye vertices of every pixel sample, in pixel order, then sample order, then branch
+/// order (reflection before refraction). Pixel sample `s` of pixel `p` draws from
+/// `Rng::for_index(pass_seed(seed, pass), p * spp + s)` after two numbers for its jitter,
+/// like every eye pass, so the list is the same for any thread count.
 pub fn eye_vertices(scene: &Scene, opts: &VertexOptions) -> Vec<EyeVertex> {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let spp = opts.spp.max(1);
@@ -71,7 +65,6 @@ pub fn eye_vertices(scene: &Scene, opts: &VertexOptions) -> Vec<EyeVertex> {
     let pixel_angle = 2.0 * (scene.camera.vfov_deg.to_radians() * 0.5).tan() / h as f32;
     let per_sample = pixel_angle / (spp as f32).sqrt();
     let seed = pass_seed(scene.seed(), opts.pass);
-    let diffuse = if opts.indirect { u32::MAX } else { 1 };
     let row = |y: usize| -> Vec<EyeVertex> {
         let mut out = Vec::new();
         let mut found = Vec::new();
@@ -82,15 +75,9 @@ pub fn eye_vertices(scene: &Scene, opts: &VertexOptions) -> Vec<EyeVertex> {
                 let [jx, jy] = rng.uniform2();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
                 found.clear();
-                walk(
-                    scene,
-                    ray,
-                    opts.splits,
-                    &mut rng,
-                    false,
-                    diffuse,
-                    &mut |f| found.push(f),
-                );
+                first_diffuse(scene, ray, opts.splits, &mut rng, false, &mut |f| {
+                    found.push(f)
+                });
                 for f in &found {
                     let ng = f.hit.point.n;
                     let facing = if f.wo.dot(ng) >= 0.0 { ng } else { -ng };
@@ -102,7 +89,6 @@ pub fn eye_vertices(scene: &Scene, opts: &VertexOptions) -> Vec<EyeVertex> {
                         weight: f.beta * f.albedo / (std::f32::consts::PI * spp as f32),
                         // A grazing view stretches the pixel's footprint (bounded at 1/0.1).
                         spacing: f.length * per_sample / f.wo.dot(facing).max(0.1),
-                        first: f.diffuse == 1,
                     });
                 }
             }
@@ -119,7 +105,7 @@ pub fn eye_vertices(scene: &Scene, opts: &VertexOptions) -> Vec<EyeVertex> {
     }
 }
 
-/// A diffuse vertex as the eye passes use it.
+/// A first diffuse vertex as the eye passes use it.
 pub(crate) struct Found {
     pub hit: Hit,
     /// Shading normal turned towards the incoming ray.
@@ -132,8 +118,6 @@ pub(crate) struct Found {
     pub length: f32,
     /// Unit direction back along the ray that arrived.
     pub wo: Vec3,
-    /// Diffuse vertices on the path so far, this one included (1: the first).
-    pub diffuse: u32,
 }
 
 #[derive(Clone, Copy)]
@@ -143,7 +127,6 @@ struct Branch {
     length: f32,
     depth: u32,
     splits: u32,
-    diffuse: u32,
 }
 
 /// Most dielectric splits one walk follows: the branches waiting on the stack are never more
@@ -167,24 +150,7 @@ pub(crate) fn first_diffuse(
     count_emission: bool,
     found: &mut dyn FnMut(Found),
 ) -> Vec3 {
-    walk(scene, ray, splits, rng, count_emission, 1, found)
-}
-
-/// [`first_diffuse`], going on past diffuse vertices until `max_diffuse` of them have been
-/// found: a diffuse vertex continues by cosine sampling (its three numbers) and, from the
-/// scene's `rr_depth` bounces on, Russian roulette as in the path tracer (a fourth number,
-/// drawn only here, so walks that stop at the first vertex keep their layout).
-fn walk(
-    scene: &Scene,
-    ray: Ray,
-    splits: u32,
-    rng: &mut Rng,
-    count_emission: bool,
-    max_diffuse: u32,
-    found: &mut dyn FnMut(Found),
-) -> Vec3 {
-    let render = scene.render();
-    let max_depth = render.max_depth;
+    let max_depth = scene.render().max_depth;
     let splits = splits.min(MAX_SPLITS);
     let lights = &scene.light_table;
     let mut emitted = Vec3::ZERO;
@@ -195,7 +161,6 @@ fn walk(
         length: 0.0,
         depth: 0,
         splits: 0,
-        diffuse: 0,
     });
     let mut len = 1;
     while len > 0 {
@@ -227,7 +192,6 @@ fn walk(
             } else {
                 -hit.ns
             };
-            let diffuse = b.diffuse + 1;
             found(Found {
                 hit,
                 n,
@@ -235,44 +199,7 @@ fn walk(
                 beta: b.beta,
                 length,
                 wo,
-                diffuse,
             });
-            if diffuse >= max_diffuse {
-                continue;
-            }
-            let u_rr = rng.uniform();
-            let frame = Frame::from_z(hit.ns);
-            let wo_l = frame.to_local(wo);
-            let Some(s) = bsdf.sample(wo_l, u_lobe, u_dir, TransportMode::Radiance) else {
-                continue;
-            };
-            let wi = frame.to_world(s.wi);
-            if !sides_agree(wo, wi, hit.point.n, wo_l, s.wi) {
-                continue;
-            }
-            let mut beta = b.beta * s.weight();
-            let depth = b.depth + 1;
-            if depth >= render.rr_depth {
-                // The path tracer's rule (PathTracer::li): survive with the throughput's
-                // largest channel, at most 0.95.
-                let q = beta.max_element().min(crate::path::MAX_SURVIVAL);
-                if u_rr >= q || q.is_nan() {
-                    continue;
-                }
-                beta /= q;
-            }
-            if beta == Vec3::ZERO || !beta.is_finite() {
-                continue;
-            }
-            stack[len] = Some(Branch {
-                ray: hit.point.spawn_ray(wi),
-                beta,
-                length: 0.0,
-                depth,
-                splits: b.splits,
-                diffuse,
-            });
-            len += 1;
             continue;
         }
         let frame = Frame::from_z(hit.ns);
@@ -313,7 +240,6 @@ fn walk(
                 length,
                 depth: b.depth + 1,
                 splits: b.splits + split as u32,
-                diffuse: b.diffuse,
             });
             len += 1;
         }

@@ -247,19 +247,19 @@ fn peak_rss_mib() -> Option<f64> {
 /// the peak memory before and after splatting ten times more photons (flat if no photon is
 /// kept).
 pub fn splat(path: &Path, photons: u64, runs: usize) -> Result<(), String> {
-    use crate::splat::{Splatter, eye_indexes};
+    use crate::splat::{Splatter, eye_index};
     let s = scene::Scene::load(path).map_err(|e| e.to_string())?;
     let settings = crate::Settings::new(&s, &crate::Overrides::default())?;
     let sp = settings.estimate.splat;
     let mut params = settings.emit.clone();
     params.photons = photons;
     let t0 = Instant::now();
-    let (eyes, later) = eye_indexes(&s, &sp, settings.estimate.spp, 0, None);
+    let eyes = eye_index(&s, &sp, settings.estimate.spp, 0, None);
     println!(
-        "scene {}, {} first and {} later eye vertices in {:.3} s, {photons} caustic photon paths per run, median of {runs}",
+        "scene {}, {} eye vertices in {:.3} s, {photons} caustic photon paths per run (indirect: {}), median of {runs}",
         path.display(),
         eyes.len(),
-        later.as_ref().map_or(0, |l| l.len()),
+        sp.indirect,
         t0.elapsed().as_secs_f64()
     );
     let (w, h) = (s.camera.width as usize, s.camera.height as usize);
@@ -268,7 +268,6 @@ pub fn splat(path: &Path, photons: u64, runs: usize) -> Result<(), String> {
         params: &params,
         settings: &sp,
         eyes: &eyes,
-        later: later.as_ref(),
     };
     for threads in [1usize, 2] {
         let mut rates = Vec::new();
@@ -298,7 +297,6 @@ pub fn splat(path: &Path, photons: u64, runs: usize) -> Result<(), String> {
         params: &many,
         settings: &sp,
         eyes: &eyes,
-        later: later.as_ref(),
     }
     .pass(0, &mut images, 2, &|_| {})?;
     match (before, peak_rss_mib()) {

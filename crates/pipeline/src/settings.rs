@@ -47,19 +47,15 @@ pub struct SplatSettings {
     /// new eye vertices; the layers are their mean. A run stopped by a time budget records
     /// the passes it made.
     pub passes: u32,
-    /// Also splat onto the later diffuse vertices of the eye paths: caustics seen through a
-    /// diffuse bounce (`caustic_indirect`), the path tracer's noisiest paths. When on, the
-    /// path tracer of `path+splat` (and `--no-caustics`) leaves those paths out too.
+    /// Also follow each caustic path past its first diffuse hit and splat it at every
+    /// later diffuse hit: caustics seen through a diffuse bounce (`caustic_indirect`), the
+    /// path tracer's noisiest paths. When on, the path tracer of `path+splat` (and
+    /// `--no-caustics`) leaves those paths out too.
     pub indirect: bool,
-    /// Radius of the disc in which a photon reaches later eye vertices, in scene units (0:
-    /// `max_radius`). A diffuse bounce blurs what it sees, so detail finer than this is not
-    /// missed; the disc keeps the vertex count a splat meets, and its noise, steady.
+    /// Radius of the disc by which a photon after a diffuse bounce reaches eye vertices, in
+    /// scene units (0: `max_radius`). A diffuse bounce spreads light too widely for finer
+    /// detail to matter, and a wide disc keeps the estimate smooth.
     pub indirect_radius: f32,
-    /// The share of photons splatted onto later eye vertices (their flux divided by it): a
-    /// later vertex's noise is mostly where its eye path went, not which photons landed near
-    /// it, and each photon meets many later vertices, so fewer photons cost less for the
-    /// same error.
-    pub indirect_share: f32,
 }
 
 impl Default for SplatSettings {
@@ -73,7 +69,6 @@ impl Default for SplatSettings {
             passes: 1,
             indirect: true,
             indirect_radius: 0.0,
-            indirect_share: 0.125,
         }
     }
 }

@@ -1,11 +1,15 @@
 //! Photon differential splatting onto eye vertices (Frisvad et al. 2014): a pass's eye
-//! vertices (E S* D, and the later diffuse vertices E S* D (S* D)+ when `indirect` is on) are
-//! indexed once; caustic photons with differentials (L S+ D, `emit`) are traced in chunks on
-//! the pipeline's workers, and each photon adds to every first eye vertex inside its
-//! footprint `Φ_p K(|M (y - x_p)|) |det M|` (`density::splat`), and to every later eye vertex
-//! inside a disc of `indirect_radius` (a diffuse bounce blurs what it sees: the argument
-//! behind final gathering, Jensen 1996, "Global illumination using photon maps"), accepting only vertices on the same surface
-//! and side. No photon is stored in a map or a file: a chunk's photons live
+//! vertices (E S* D) are indexed once; caustic photons with differentials (L S+ D, `emit`)
+//! are traced in chunks on the pipeline's workers, and each photon adds to every eye vertex
+//! inside its footprint `Φ_p K(|M (y - x_p)|) |det M|` (`density::splat`), accepting only
+//! vertices on the same surface and side. With `indirect` on, each caustic path goes on past
+//! its first diffuse hit and adds at every later diffuse hit (L S+ D (S* D)+) by a disc of
+//! `indirect_radius` instead: after a diffuse bounce the photons no longer focus, and their
+//! density is as smooth as a global photon map's, so the caustics seen through a diffuse
+//! bounce (the path tracer's fireflies) come from photons landing where the eye looks,
+//! not from eye paths that must find a small bright focus (the idea of Jensen's caustic and
+//! global maps, 1996, kept free of any map).
+//! No photon is stored in a map or a file: a chunk's photons live
 //! only while its worker splats them, and what crosses the channel to the ordering stage is
 //! the chunk's pixel contributions, added in chunk order (so the image is the same for any
 //! thread count).
@@ -24,9 +28,6 @@ use scene::Scene;
 const TOPO_EPS: f32 = 0.1;
 /// Smallest cosine between a vertex's normal and the photon's: same surface, same side.
 const SAME_SIDE_COS: f32 = 0.9;
-
-/// Decorrelates the photon roulette of [`splat`] from other uses of the path index.
-const SHARE_SALT: u64 = 0x7368_6172_6520_7370;
 
 /// Eye vertices under a kd-tree.
 pub struct EyeIndex {
@@ -56,30 +57,23 @@ impl EyeIndex {
     }
 }
 
-/// The eye vertices of pass `pass` (`spp` pixel samples each), indexed: the first diffuse
-/// vertices, and the later ones when the settings ask for them.
-pub fn eye_indexes(
+/// The first eye vertices of pass `pass` (`spp` pixel samples each), indexed.
+pub fn eye_index(
     scene: &Scene,
     s: &SplatSettings,
     spp: u32,
     pass: u64,
     threads: Option<usize>,
-) -> (EyeIndex, Option<EyeIndex>) {
-    let all = eye::eye_vertices(
+) -> EyeIndex {
+    EyeIndex::new(eye::eye_vertices(
         scene,
         &VertexOptions {
             spp,
             splits: s.splits,
             threads,
             pass,
-            indirect: s.indirect,
         },
-    );
-    if !s.indirect {
-        return (EyeIndex::new(all), None);
-    }
-    let (first, later): (Vec<EyeVertex>, Vec<EyeVertex>) = all.into_iter().partition(|v| v.first);
-    (EyeIndex::new(first), Some(EyeIndex::new(later)))
+    ))
 }
 
 /// Scratch space of one worker.
@@ -109,16 +103,12 @@ pub fn footprint(
 
 /// Adds what `photons` deposit at the eye vertices to `out`, as `(pixel, radiance)` pairs
 /// in photon order, then vertex order. `isotropic > 0` replaces every footprint by a disc of
-/// that radius (the fixed-radius splatting that differentials improve on). `share < 1`
-/// splats each photon with that probability (a pure function of its path index), its flux
-/// divided by it: Russian roulette on photons, unbiased, for vertices whose noise is not the
-/// photons' (see [`SplatSettings::indirect_share`]).
+/// that radius (the fixed-radius splatting that differentials improve on).
 pub fn splat(
     eyes: &EyeIndex,
     photons: &[CausticPhoton],
     max_radius: f32,
     isotropic: f32,
-    share: f64,
     scratch: &mut Scratch,
     out: &mut Vec<(u32, DVec3)>,
 ) {
@@ -126,15 +116,7 @@ pub fn splat(
         if !p.flux.is_finite() {
             continue;
         }
-        let mut flux = p.flux.as_dvec3();
-        if share < 1.0 {
-            // 53 random bits of the path index.
-            let u = (math::mix64(p.path ^ SHARE_SALT) >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
-            if u >= share {
-                continue;
-            }
-            flux /= share;
-        }
+        let flux = p.flux.as_dvec3();
         let f = if isotropic > 0.0 {
             let frame = math::Frame::from_z(p.normal);
             Footprint::new(
@@ -169,8 +151,8 @@ pub fn splat(
     }
 }
 
-/// The radius of the disc in which photons reach later eye vertices: the setting, or the
-/// largest footprint semi-axis.
+/// The radius of the disc by which photons after a diffuse bounce reach eye vertices: the
+/// setting, or the largest footprint semi-axis.
 pub fn indirect_radius(scene: &Scene, s: &SplatSettings) -> f32 {
     if s.indirect_radius > 0.0 {
         s.indirect_radius
@@ -194,23 +176,23 @@ pub fn max_radius(scene: &Scene, s: &SplatSettings) -> f32 {
 }
 
 /// What a splatting pass needs: the scene, its caustic paths' parameters (`params.photons`
-/// per pass, `params.max_depth`), the splat settings and the indexed eye vertices (first, and
-/// later ones if any).
+/// per pass, `params.max_depth`), the splat settings and the indexed eye vertices.
 pub struct Splatter<'a> {
     pub scene: &'a Scene,
     pub params: &'a EmitParams,
     pub settings: &'a SplatSettings,
     pub eyes: &'a EyeIndex,
-    pub later: Option<&'a EyeIndex>,
 }
 
-/// One chunk's photon count and its `(pixel, radiance)` pairs at first and at later vertices.
+/// One chunk's photon count and its `(pixel, radiance)` pairs: `[0]` from photons at their
+/// first diffuse hit, `[1]` from photons after further diffuse bounces.
 type Chunk = (u64, [Vec<(u32, DVec3)>; 2]);
 
 impl Splatter<'_> {
     /// One pass of the caustic layers: the caustic paths of pass `pass` splatted onto the eye
-    /// vertices and added to `images` (one f64 RGB sum per pixel; `[0]` at first vertices,
-    /// `[1]` at later ones) in chunk order.
+    /// vertices and added to `images` (one f64 RGB sum per pixel; `[0]` the `caustic` layer,
+    /// `[1]` `caustic_indirect`, left alone unless the settings' `indirect` is on) in chunk
+    /// order.
     pub fn pass(
         &self,
         pass: u64,
@@ -219,33 +201,28 @@ impl Splatter<'_> {
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<TraceStats, String> {
         let (scene, params, s, eyes) = (self.scene, self.params, self.settings, self.eyes);
+        if s.indirect && images[1].len() != images[0].len() {
+            return Err("splatting caustic_indirect needs an image for it".into());
+        }
         let max_r = max_radius(scene, s);
         let indirect_r = indirect_radius(scene, s);
         let work = |range: std::ops::Range<u64>| -> Chunk {
             let n = range.end - range.start;
-            let photons = emit::trace_caustics(scene, params, s.scale, pass, range);
+            let photons = emit::trace_caustics(scene, params, s.scale, pass, range, s.indirect);
+            let (first, bounced): (Vec<CausticPhoton>, Vec<CausticPhoton>) =
+                photons.into_iter().partition(|p| p.diffuse == 1);
             let mut out = [Vec::new(), Vec::new()];
             let mut scratch = Scratch::default();
+            let iso = s.isotropic_radius;
+            splat(eyes, &first, max_r, iso, &mut scratch, &mut out[0]);
             splat(
                 eyes,
-                &photons,
-                max_r,
-                s.isotropic_radius,
-                1.0,
+                &bounced,
+                indirect_r,
+                indirect_r,
                 &mut scratch,
-                &mut out[0],
+                &mut out[1],
             );
-            if let Some(later) = self.later {
-                splat(
-                    later,
-                    &photons,
-                    indirect_r,
-                    indirect_r,
-                    s.indirect_share.clamp(0.0, 1.0) as f64,
-                    &mut scratch,
-                    &mut out[1],
-                );
-            }
             (n, out)
         };
         flow::run_chunks(

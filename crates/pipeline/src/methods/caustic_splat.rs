@@ -9,8 +9,8 @@ use crate::splat;
 /// JSON facts for `image.json`.
 type Facts = serde_json::Map<String, serde_json::Value>;
 
-/// The splatted caustic layers (`caustic`, and `caustic_indirect` when the settings splat
-/// onto later eye vertices), the passes made and the JSON facts.
+/// The splatted caustic layers (`caustic`, and `caustic_indirect` when the settings follow
+/// caustic paths past their first diffuse hit), the passes made and the JSON facts.
 pub(super) fn caustic_layers(
     run: &Run,
     progress: &(dyn Fn(u64) + Sync),
@@ -36,20 +36,17 @@ pub(super) fn caustic_layers(
     let mut t_vertices = 0.0;
     let mut passes = 0u32;
     let mut max_in_flight = 0;
-    let mut vertices = [0usize; 2];
+    let mut vertices = 0;
     while passes < sp.passes {
         let t0 = std::time::Instant::now();
-        let (eyes, later) =
-            splat::eye_indexes(run.scene, sp, s.estimate.spp, passes as u64, run.threads);
+        let eyes = splat::eye_index(run.scene, sp, s.estimate.spp, passes as u64, run.threads);
         t_vertices += t0.elapsed().as_secs_f64();
-        vertices[0] += eyes.len();
-        vertices[1] += later.as_ref().map_or(0, |l| l.len());
+        vertices += eyes.len();
         let splatter = splat::Splatter {
             scene: run.scene,
             params: &params,
             settings: sp,
             eyes: &eyes,
-            later: later.as_ref(),
         };
         let stats = splatter.pass(passes as u64, &mut images, run.threads(), progress)?;
         max_in_flight = max_in_flight.max(stats.max_in_flight);
@@ -75,8 +72,7 @@ pub(super) fn caustic_layers(
     for (k, v) in [
         ("splat", serde_json::json!(sp)),
         ("splat_photons_emitted", params.photons.into()),
-        ("eye_vertices", vertices[0].into()),
-        ("eye_vertices_later", vertices[1].into()),
+        ("eye_vertices", vertices.into()),
         (
             "splat_indirect_radius",
             splat::indirect_radius(run.scene, sp).into(),
