@@ -80,6 +80,18 @@ pub fn chunks(total: u64, chunk: u64) -> impl Iterator<Item = Range<u64>> {
 /// A path also ends when nothing it can still do reaches a planned set: a diffuse bounce when
 /// only the caustic set is planned, everything when neither is.
 pub fn trace_range(scene: &Scene, params: &EmitParams, plan: &Plan, range: Range<u64>) -> Traced {
+    trace_pass(scene, params, plan, 0, range)
+}
+
+/// [`trace_range`] for pass `pass` of a progressive method: path `i` draws from the stream
+/// `(seed, pass, i)` ([`crate::pass_stream`]); pass 0 is `trace_range` itself.
+pub fn trace_pass(
+    scene: &Scene,
+    params: &EmitParams,
+    plan: &Plan,
+    pass: u64,
+    range: Range<u64>,
+) -> Traced {
     let mut out = Traced {
         emitted: range.end.saturating_sub(range.start),
         ..Traced::default()
@@ -91,6 +103,7 @@ pub fn trace_range(scene: &Scene, params: &EmitParams, plan: &Plan, range: Range
         scene,
         params,
         plan,
+        stream: crate::pass_stream(scene.seed(), pass),
     };
     for i in range {
         tracer.trace_path(i, &mut out);
@@ -141,11 +154,13 @@ struct Tracer<'a> {
     scene: &'a Scene,
     params: &'a EmitParams,
     plan: &'a Plan,
+    /// Seed of the pass's photon streams.
+    stream: u64,
 }
 
 impl Tracer<'_> {
     fn trace_path(&self, index: u64, out: &mut Traced) {
-        let mut rng = Rng::for_index(self.scene.seed() ^ EMIT_STREAM, index);
+        let mut rng = Rng::for_index(self.stream, index);
         // Fixed layout: 5 numbers to emit, then 3 per hit, used or not.
         let (u_light, u_pos, u_dir) = (rng.uniform(), rng.uniform2(), rng.uniform2());
         let e = self

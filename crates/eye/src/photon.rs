@@ -72,7 +72,7 @@ pub fn render_final_gather(
                 let mut out = [emitted, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO];
                 for v in verts {
                     let brdf = v.beta * v.albedo / std::f32::consts::PI;
-                    out[1] += ctx.direct(v, rng) * brdf;
+                    out[1] += direct_at(scene, v, rng) * brdf;
                     out[2] += brdf * maps.irradiance(MapLookup::Caustic, v.hit.point.p, v.n);
                     out[3] += ctx.gather(v, rays, rng) * (v.beta * v.albedo);
                 }
@@ -114,26 +114,6 @@ impl Ctx<'_> {
         })
     }
 
-    /// Irradiance at the vertex from the lights by one shadow ray (next-event estimation).
-    fn direct(&self, v: &Vertex, rng: &mut Rng) -> Vec3 {
-        let (u_pick, u) = (rng.uniform(), rng.uniform2());
-        let Some(ls) = self.scene.light_table.sample(v.hit.point.p, u_pick, u) else {
-            return Vec3::ZERO;
-        };
-        let cos = ls.wi.dot(v.n);
-        if cos <= 0.0 || ls.wi.dot(v.hit.point.n) * v.n.dot(v.hit.point.n) <= 0.0 {
-            return Vec3::ZERO;
-        }
-        if self
-            .scene
-            .geometry
-            .occluded(&v.hit.point.spawn_ray_to_point(&ls.point))
-        {
-            return Vec3::ZERO;
-        }
-        ls.le * (cos / ls.pdf)
-    }
-
     /// Mean radiance arriving at the vertex over `rays` cosine-distributed gather rays, read
     /// from the global map where they land (emission excluded: next-event estimation owns it).
     /// Times `albedo` this is the indirect radiance (the cosine pdf cancels `cos / pi`).
@@ -159,4 +139,23 @@ impl Ctx<'_> {
         }
         (sum / rays as f64).as_vec3()
     }
+}
+
+/// Irradiance at the vertex from the lights by one shadow ray (next-event estimation).
+pub(crate) fn direct_at(scene: &Scene, v: &Vertex, rng: &mut Rng) -> Vec3 {
+    let (u_pick, u) = (rng.uniform(), rng.uniform2());
+    let Some(ls) = scene.light_table.sample(v.hit.point.p, u_pick, u) else {
+        return Vec3::ZERO;
+    };
+    let cos = ls.wi.dot(v.n);
+    if cos <= 0.0 || ls.wi.dot(v.hit.point.n) * v.n.dot(v.hit.point.n) <= 0.0 {
+        return Vec3::ZERO;
+    }
+    if scene
+        .geometry
+        .occluded(&v.hit.point.spawn_ray_to_point(&ls.point))
+    {
+        return Vec3::ZERO;
+    }
+    ls.le * (cos / ls.pdf)
 }

@@ -61,7 +61,11 @@ pub fn write(
     // A run stopped by a time budget is reproduced by the passes it made.
     let mut settings = settings.clone();
     if let Some(p) = r.passes {
-        settings.estimate.splat.passes = p;
+        if settings.method == scene::Method::Sppm {
+            settings.estimate.sppm.passes = p;
+        } else {
+            settings.estimate.splat.passes = p;
+        }
     }
     let settings = &settings;
     let resolved = settings.resolved_scene(scene)?;
@@ -75,6 +79,30 @@ pub fn write(
         exposure: o.exposure,
         ..ToneMap::default()
     };
+    // Snapshots of a progressive run: each image with its passes, seconds and, against the
+    // reference, its error; one run gives an error-against-time series.
+    let mut snapshot_images = Vec::new();
+    let mut snapshots = Vec::new();
+    for snap in &r.snapshots {
+        let parts: Vec<(&Image, f32)> = snap.layers.iter().map(|l| (&l.image, 1.0)).collect();
+        let img = film::composite(&parts).map_err(|e| e.to_string())?;
+        let m = match o.reference {
+            Some((p, reference)) => Some(
+                film::metrics(&img, reference, None)
+                    .map_err(|e| format!("{}: {e}", p.display()))?,
+            ),
+            None => None,
+        };
+        let file = format!("snapshots/pass-{:05}.exr", snap.passes);
+        snapshots.push(serde_json::json!({
+            "passes": snap.passes,
+            "seconds": snap.seconds,
+            "image": file,
+            "relmse": m.as_ref().map(|m| m.relmse),
+            "rmse": m.as_ref().map(|m| m.rmse),
+        }));
+        snapshot_images.push((file, img));
+    }
     let mut json = serde_json::json!({
         "scene": scene.path.display().to_string(),
         "scene_hash": format!("{:016x}", scene.content_hash),
@@ -118,6 +146,12 @@ pub fn write(
         for (k, v) in &r.info {
             obj.insert(k.clone(), v.clone());
         }
+        if !snapshots.is_empty() {
+            obj.insert(
+                "snapshots".into(),
+                serde_json::Value::Array(snapshots.clone()),
+            );
+        }
     }
     let json_text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
 
@@ -130,10 +164,12 @@ pub fn write(
     for name in ["image.json", "scene.toml", "plan.txt"] {
         remove_if_present(&out.join(name))?;
     }
-    if let Ok(dir) = std::fs::read_dir(out.join("layers")) {
-        for e in dir.flatten() {
-            if e.path().extension().is_some_and(|x| x == "exr") {
-                remove_if_present(&e.path())?;
+    for sub in ["layers", "snapshots"] {
+        if let Ok(dir) = std::fs::read_dir(out.join(sub)) {
+            for e in dir.flatten() {
+                if e.path().extension().is_some_and(|x| x == "exr") {
+                    remove_if_present(&e.path())?;
+                }
             }
         }
     }
@@ -142,6 +178,13 @@ pub fn write(
     for l in &r.layers {
         film::write_exr(out.join("layers").join(format!("{}.exr", l.name)), &l.image)
             .map_err(|e| e.to_string())?;
+    }
+    if !snapshot_images.is_empty() {
+        std::fs::create_dir_all(out.join("snapshots"))
+            .map_err(|e| format!("{}: cannot create snapshots/: {e}", out.display()))?;
+    }
+    for (file, img) in &snapshot_images {
+        film::write_exr(out.join(file), img).map_err(|e| e.to_string())?;
     }
     let w = |name: &str, bytes: &[u8]| {
         film::write_atomic(&out.join(name), bytes).map_err(|e| e.to_string())

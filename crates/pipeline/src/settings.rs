@@ -25,6 +25,38 @@ pub struct EstimateSettings {
     pub caustic: EstimateParams,
     pub final_gather: FinalGatherSettings,
     pub splat: SplatSettings,
+    pub sppm: SppmSettings,
+}
+
+/// `[estimate.sppm]`: stochastic progressive photon mapping (Hachisuka and Jensen 2009;
+/// pbrt-v4 §16.2). Kernel, same-side and topological tests are `[estimate.global]`'s.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SppmSettings {
+    /// Photon paths per pass (0: `[photons] photons`).
+    pub photons: u64,
+    /// Passes: each draws one new camera sample per pixel and `photons` new paths.
+    pub passes: u32,
+    /// The share of new photons a visible point keeps: radii shrink as
+    /// `R' = R sqrt((N + alpha M) / (N + M))`; in (0, 1).
+    pub alpha: f32,
+    /// Start radius in scene units (0: automatic, from the scene's diffuse area, the photons
+    /// per pass and the pixel footprint; see `sppm::start_radius`).
+    pub radius: f32,
+    /// Direct light by next-event estimation at the visible points (else photons carry it).
+    pub direct: bool,
+}
+
+impl Default for SppmSettings {
+    fn default() -> Self {
+        SppmSettings {
+            photons: 0,
+            passes: 16,
+            alpha: 2.0 / 3.0,
+            radius: 0.0,
+            direct: true,
+        }
+    }
 }
 
 /// `[estimate.splat]`: photon differential splatting (Frisvad et al. 2014).
@@ -108,6 +140,7 @@ impl Default for EstimateSettings {
             },
             final_gather: FinalGatherSettings::default(),
             splat: SplatSettings::default(),
+            sppm: SppmSettings::default(),
         }
     }
 }
@@ -206,7 +239,11 @@ impl Settings {
             estimate.final_gather.cache = c;
         }
         if let Some(p) = o.passes {
-            estimate.splat.passes = p;
+            if method == Method::Sppm {
+                estimate.sppm.passes = p;
+            } else {
+                estimate.splat.passes = p;
+            }
         }
         if let Some(n) = o.splat_photons {
             estimate.splat.photons = n;
@@ -316,6 +353,19 @@ impl Settings {
             return Err(format!(
                 "estimate.splat.passes = {} must be in 1..=1048576",
                 sp.passes
+            ));
+        }
+        let sm = &e.sppm;
+        if sm.passes == 0 || sm.passes > 1 << 20 || sm.photons > 1 << 40 {
+            return Err(format!(
+                "estimate.sppm: passes = {} must be in 1..=1048576 and photons = {} at most 2^40",
+                sm.passes, sm.photons
+            ));
+        }
+        if !(sm.alpha > 0.0 && sm.alpha < 1.0 && sm.radius >= 0.0 && sm.radius.is_finite()) {
+            return Err(format!(
+                "estimate.sppm: alpha = {} must be in (0, 1) and radius = {} finite and >= 0",
+                sm.alpha, sm.radius
             ));
         }
         if sp.photons > 1 << 40 || sp.splits > 16 {

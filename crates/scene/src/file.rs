@@ -111,16 +111,20 @@ pub enum Method {
     /// The path tracer without the paths splatting owns, plus the splatted caustic layer.
     #[serde(rename = "path+splat")]
     PathSplat,
+    /// Stochastic progressive photon mapping (Hachisuka and Jensen 2009): visible points per
+    /// pixel, photons in passes, radii shrinking per pixel; consistent.
+    Sppm,
 }
 
 impl Method {
     /// Every method, in declaration order.
-    pub const ALL: [Method; 5] = [
+    pub const ALL: [Method; 6] = [
         Method::Path,
         Method::GlobalDirect,
         Method::FinalGather,
         Method::CausticSplat,
         Method::PathSplat,
+        Method::Sppm,
     ];
 
     /// The method's name as the scene file spells it.

@@ -115,5 +115,6 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
         plan: None,
         info,
         passes: Some(passes),
+        snapshots: Vec::new(),
     })
 }

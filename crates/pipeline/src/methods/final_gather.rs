@@ -70,5 +70,6 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
         plan: Some(inputs.plan),
         info,
         passes: None,
+        snapshots: Vec::new(),
     })
 }

@@ -9,6 +9,9 @@ mod final_gather;
 mod global_direct;
 mod path;
 mod path_splat;
+mod sppm;
+
+pub use sppm::start_radius;
 
 use crate::maps::Maps;
 use crate::photon_cache::{self, CacheKey};
@@ -86,6 +89,17 @@ pub struct Rendered {
     pub info: serde_json::Map<String, serde_json::Value>,
     /// Photon passes made, for progressive methods (the resolved scene records them).
     pub passes: Option<u32>,
+    /// The image after 1, 2, 4, 8, ... passes and the last, for progressive methods: one
+    /// run gives an error-against-time series.
+    pub snapshots: Vec<Snapshot>,
+}
+
+/// A progressive method's image after some passes.
+pub struct Snapshot {
+    pub passes: u32,
+    /// Seconds since the passes began.
+    pub seconds: f64,
+    pub layers: Vec<Layer>,
 }
 
 /// What a layer's count counts: the compositing stage's own type, so `image.json` is spelled
@@ -117,6 +131,8 @@ pub fn spec(method: Method) -> MethodSpec {
             Method::CausticSplat => (caustic_splat::render, false, true, true),
             // The path tracer's spp; its splat's eye vertices take `[estimate] spp`.
             Method::PathSplat => (path_splat::render, false, false, false),
+            // One camera sample per pixel and pass; progress counts them.
+            Method::Sppm => (sppm::render, false, false, false),
         };
     MethodSpec {
         render,
@@ -140,7 +156,11 @@ pub fn work(run: &Run) -> u64 {
         run.scene.camera.width as u64,
         run.scene.camera.height as u64,
     );
-    w * h * run.settings.spp() as u64
+    let samples = match run.settings.method {
+        Method::Sppm => run.settings.estimate.sppm.passes,
+        _ => run.settings.spp(),
+    };
+    w * h * samples as u64
 }
 
 /// How one film layer is described: name, classes, count, count kind.

@@ -61,5 +61,6 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
         plan: None,
         info,
         passes: None,
+        snapshots: Vec::new(),
     })
 }

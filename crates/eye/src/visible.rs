@@ -1,0 +1,89 @@
+//! Visible points for progressive photon mapping (Hachisuka and Jensen 2009, "Stochastic
+//! progressive photon mapping"; pbrt-v4 §16.2): each pass, one camera sample per pixel is
+//! followed through specular surfaces to its first diffuse vertex (E S* D, one Fresnel branch
+//! chosen at glass), where photons will be gathered. Emission met on the way and direct light
+//! by next-event estimation at the vertex are added here, so the photons need carry only
+//! light that has bounced at least once.
+
+use crate::photon::direct_at;
+use crate::vertices::first_diffuse;
+use glam::Vec3;
+use math::Rng;
+use rayon::prelude::*;
+use scene::Scene;
+
+/// Where one pixel's camera sample of a pass first met a diffuse surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VisiblePoint {
+    pub p: Vec3,
+    /// Unit shading normal on the side the eye path arrived from.
+    pub n: Vec3,
+    /// Radiance sent to the pixel per unit irradiance at `p`: the specular chain's throughput
+    /// times `albedo / π`.
+    pub weight: Vec3,
+}
+
+/// One pixel's camera sample of a pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelSample {
+    /// Emission seen through specular chains, plus (when asked for) direct light at the
+    /// visible point by next-event estimation.
+    pub light: Vec3,
+    pub point: Option<VisiblePoint>,
+}
+
+/// One sample per pixel, in pixel order. Pixel `p` draws from
+/// `Rng::for_index(pass_seed(seed, pass), p)`: two numbers of jitter, three per hit of the
+/// walk, three for next-event estimation, so the samples are the same for any thread count.
+/// `direct`: add next-event estimation at the visible point (else photons must bring direct
+/// light too).
+pub fn visible_points(
+    scene: &Scene,
+    pass: u64,
+    direct: bool,
+    threads: Option<usize>,
+) -> Vec<PixelSample> {
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    let seed = crate::vertices::pass_seed(scene.seed(), pass);
+    let row = |y: usize| -> Vec<PixelSample> {
+        (0..w)
+            .map(|x| {
+                let pixel = (y * w + x) as u64;
+                let mut rng = Rng::for_index(seed, pixel);
+                let [jx, jy] = rng.uniform2();
+                let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
+                let mut found = None;
+                let emitted =
+                    first_diffuse(scene, ray, 0, &mut rng, true, &mut |f| found = Some(f));
+                let mut out = PixelSample {
+                    light: emitted,
+                    point: None,
+                };
+                if let Some(v) = found {
+                    let weight = v.beta * v.albedo / std::f32::consts::PI;
+                    if direct {
+                        out.light += direct_at(scene, &v, &mut rng) * weight;
+                    }
+                    out.point = Some(VisiblePoint {
+                        p: v.hit.point.p,
+                        n: v.n,
+                        weight,
+                    });
+                }
+                out
+            })
+            .collect()
+    };
+    let work = || -> Vec<PixelSample> { (0..h).into_par_iter().flat_map_iter(row).collect() };
+    match opts_pool(threads) {
+        Some(pool) => pool.install(work),
+        None => work(),
+    }
+}
+
+fn opts_pool(threads: Option<usize>) -> Option<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads?)
+        .build()
+        .ok()
+}
