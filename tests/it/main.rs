@@ -11,8 +11,11 @@
 //! - `splat`: photon differential splatting through the pipeline library: the splatted
 //!   caustic and `path+splat` against the path tracer on the worksheet scene, bounded chunks
 //!   in flight, a hostile scene (finite pixels, flux kept), the same bits on 1 and 2 threads.
+//! - `sppm`: progressive photon mapping converging to closed forms (square light, furnace) at
+//!   the rate its radius schedule predicts; snapshots, time budget, thread-count invariance.
 
 mod cornell;
 mod photon_maps;
 mod photons;
 mod splat;
+mod sppm;

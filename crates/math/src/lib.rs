@@ -7,6 +7,7 @@
 //! indexed by the photon's number, not drawn from a shared stream).
 //! Vectors are `glam`'s; this crate adds what glam lacks.
 
+pub mod analytic;
 pub mod chi2;
 mod frame;
 mod rng;
