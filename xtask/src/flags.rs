@@ -4,12 +4,15 @@ pub const HELP: &str = "\
 cargo xtask <command>   (every command builds the release `photonflow` binary and runs it;
                          `photonflow <command> --help` lists all options)
 
-  render SCENE [--method path|global-direct|final-gather] [--spp N] [--threads N] [--out DIR]
+  render SCENE [--method path|global-direct|final-gather|caustic-splat|path+splat|sppm]
+               [--spp N] [--passes N] [--time S] [--threads N] [--out DIR]
                       render with a progress bar; writes image.exr, image.png, layers/, image.json
                       and scene.toml (the resolved scene: renders the same image again).
                       path: the path-traced reference (--no-caustics leaves out L S+ D light);
                       the photon methods chain trace (or reuse the cache) -> estimate -> composite;
-                      without --method: the scene's render.method (default final-gather)
+                      sppm and the splatting methods run in passes (--passes, --time) and
+                      write snapshots at 1, 2, 4, ... passes;
+                      without --method: the scene's render.method (default sppm)
   trace SCENE [--photons N] [--cache DIR] [--threads N] [--force]
                       trace the photon sets the scene's effects plan asks for into the cache,
                       or reuse them when the scene and parameters are unchanged
@@ -40,6 +43,11 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
   bench splat [SCENE] [--photons N] [--runs N]
                       caustic photons splatted per second on 1 and 2 threads, eye vertices,
                       peak memory (default scene: scenes/cornell-spheres/analytic.toml)
+  bench accuracy [SCENE] [--reference EXR] [--reference-spp N] [--peer NAME=CMD]...
+                      the time each method (path+splat, final-gather, sppm, and peers: shell
+                      commands writing an EXR to $OUT) needs to reach the relative MSE of the
+                      256-spp path-traced image, and its ratio to the path tracer's time, in
+                      one run, against a reference rendered once (4096 spp) and cached
   bench knn [--photons N] [--queries N]
                       k-NN queries/s for k = 50, 250, 1000 per index (kd-tree, kiddo, brute),
                       and pixel-order irradiance queries with radius hints
@@ -86,7 +94,7 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
         )),
         [
             "bench",
-            what @ ("rays" | "photons" | "store" | "knn" | "splat"),
+            what @ ("rays" | "photons" | "store" | "knn" | "splat" | "accuracy"),
             rest @ ..,
         ] => {
             let mut out = vec![format!("bench-{what}")];
@@ -94,8 +102,8 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
             if rest.first().is_none_or(|s| s.starts_with("--")) {
                 match *what {
                     "rays" | "photons" => out.push(DEFAULT_SCENE.into()),
-                    // Splatting measures the worksheet's caustics on exact spheres.
-                    "splat" => out.push(SPLAT_SCENE.into()),
+                    // Splatting and accuracy measure the worksheet scene with exact spheres.
+                    "splat" | "accuracy" => out.push(SPLAT_SCENE.into()),
                     _ => {}
                 }
             }

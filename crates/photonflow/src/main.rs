@@ -59,6 +59,25 @@ enum Cmd {
         #[arg(long, default_value_t = 3)]
         runs: usize,
     },
+    /// Time each method needs to reach the error of a 256-spp path-traced image, against a
+    /// long path-traced reference (rendered once and cached, or given), in one run.
+    BenchAccuracy {
+        scene: PathBuf,
+        /// A linear RGB EXR of the same view from any renderer (else a path-traced one is
+        /// rendered once into --dir and reused).
+        #[arg(long)]
+        reference: Option<PathBuf>,
+        /// Samples per pixel of the rendered reference.
+        #[arg(long, default_value_t = 4096)]
+        reference_spp: u32,
+        /// Another renderer timed in the same run: NAME=COMMAND, a shell command that writes
+        /// a linear EXR of the same view to the path in $OUT. Repeatable.
+        #[arg(long, value_parser = parse_peer)]
+        peer: Vec<(String, String)>,
+        /// Where runs, snapshots and the cached reference go.
+        #[arg(long, default_value = "out/bench/accuracy")]
+        dir: PathBuf,
+    },
     /// k-NN queries/s for k = 50, 250, 1000 for each index.
     BenchKnn {
         #[arg(long, default_value_t = 1_000_000)]
@@ -70,8 +89,8 @@ enum Cmd {
     /// `final-gather` chain trace (or reuse the cached photons) → estimate → composite.
     Render {
         scene: PathBuf,
-        /// path, global-direct, final-gather, caustic-splat or path+splat (default: the
-        /// scene's render.method, whose default is final-gather).
+        /// path, global-direct, final-gather, caustic-splat, path+splat or sppm (default: the
+        /// scene's render.method, whose default is sppm).
         #[arg(long)]
         method: Option<Method>,
         #[command(flatten)]
@@ -155,6 +174,16 @@ enum Cmd {
         #[arg(long, value_parser = parse_rect)]
         mask: Option<[usize; 4]>,
     },
+}
+
+/// `NAME=COMMAND` of `--peer`.
+fn parse_peer(s: &str) -> Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((name, cmd)) if !name.is_empty() && !cmd.is_empty() => {
+            Ok((name.to_string(), cmd.to_string()))
+        }
+        _ => Err(format!("`{s}`: expected NAME=COMMAND")),
+    }
 }
 
 /// Image settings shared by `render` and `estimate`.
@@ -393,6 +422,19 @@ fn run(cmd: Cmd) -> Result<(), String> {
             runs,
         } => pipeline::bench::splat(&scene, photons, runs),
         Cmd::BenchKnn { photons, queries } => pipeline::bench::knn(photons, queries),
+        Cmd::BenchAccuracy {
+            scene,
+            reference,
+            reference_spp,
+            peer,
+            dir,
+        } => {
+            let peers: Vec<pipeline::accuracy::Peer> = peer
+                .into_iter()
+                .map(|(name, command)| pipeline::accuracy::Peer { name, command })
+                .collect();
+            pipeline::accuracy::accuracy(&scene, reference.as_deref(), reference_spp, &peers, &dir)
+        }
         Cmd::Worksheet {
             scene,
             photons,

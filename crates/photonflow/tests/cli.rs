@@ -345,8 +345,8 @@ fn a_truncated_cache_file_is_traced_anew() {
 }
 
 #[test]
-fn render_without_a_method_runs_the_framework_standard_deterministically() {
-    // The scene's render.method defaults to final-gather: trace → estimate → composite.
+fn render_final_gather_runs_the_framework_standard_deterministically() {
+    // Final gathering chains trace → estimate → composite.
     let dir = Scratch::new("fg", &[]);
     let cache = dir.0.join("cache");
     let mut images = Vec::new();
@@ -355,6 +355,8 @@ fn render_without_a_method_runs_the_framework_standard_deterministically() {
         let o = photonflow(&[
             "render",
             "scenes/corner/corner.toml",
+            "--method",
+            "final-gather",
             "--photons",
             "20000",
             "--k",

@@ -17,6 +17,7 @@
 //!
 //! File IO happens only at paths the caller passes in.
 
+pub mod accuracy;
 pub mod bench;
 pub mod boundary;
 pub mod flow;

@@ -179,6 +179,14 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
         passes += 1;
         progress((w * h) as u64);
         let elapsed = t0.elapsed().as_secs_f64();
+        // Passes left: to the count, or to the time budget if that comes first.
+        let left = (sp.passes - passes) as f64 * elapsed / passes as f64;
+        let left = s.time.map_or(left, |t| left.min((t - elapsed).max(0.0)));
+        eprintln!(
+            "sppm pass {passes}/{}: {elapsed:.2} s, {:.3} M photon paths/s, about {left:.1} s left",
+            sp.passes,
+            (passes as u64 * params.photons) as f64 / elapsed / 1e6
+        );
         if passes.is_power_of_two() || passes == sp.passes {
             snapshots.push(Snapshot {
                 passes,
