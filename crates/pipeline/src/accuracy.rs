@@ -63,11 +63,7 @@ fn reference(scene: &Scene, given: Option<&Path>, spp: u32, dir: &Path) -> Resul
     if let Some(p) = given {
         return Ok(p.to_path_buf());
     }
-    let cached = dir.join(format!(
-        "reference-{:016x}-seed{}-{spp}spp",
-        scene.view_hash,
-        scene.seed()
-    ));
+    let cached = dir.join(format!("reference-{:016x}-{spp}spp", scene.view_hash));
     let exr = cached.join("image.exr");
     if exr.is_file() && cached.join("image.json").is_file() {
         println!("reference: {} (cached)", exr.display());
@@ -197,9 +193,15 @@ pub fn accuracy(
         &cache,
     )?;
     println!("sppm             64 passes {seconds:8.2} s  relMSE {relmse:.5} (whole run)");
-    let rungs: Vec<Rung> = snapshots(&out)?
+    // Snapshot times count from the first pass; the run's loading and writing come on top.
+    let snaps = snapshots(&out)?;
+    let overhead = snaps
+        .last()
+        .map_or(0.0, |&(_, s, _)| (seconds - s).max(0.0));
+    let rungs: Vec<Rung> = snaps
         .into_iter()
         .map(|(p, s, e)| {
+            let s = s + overhead;
             println!("sppm          {p:>5} passes {s:8.2} s  relMSE {e:.5} (snapshot)");
             Rung {
                 budget: format!("{p} passes"),
@@ -209,8 +211,10 @@ pub fn accuracy(
         })
         .collect();
     table.push(("sppm".into(), rungs));
+    // Peers run from anywhere: give them an absolute path.
+    let abs = std::fs::canonicalize(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     for peer in peers {
-        let exr = dir.join(format!("peer-{}.exr", peer.name));
+        let exr = abs.join(format!("peer-{}.exr", peer.name));
         let _ = std::fs::remove_file(&exr);
         let t0 = Instant::now();
         let status = std::process::Command::new("sh")
