@@ -28,9 +28,17 @@ fn scene_with(rel: &str, seed: u64, res: u32, sppm: &str) -> Scene {
 }
 
 fn render(scene: &Scene, passes: u32, threads: Option<usize>) -> Rendered {
+    render_method(scene, Method::Sppm, passes, threads)
+}
+
+/// `method` with `passes` passes (for `path+splat`, as many path-traced samples per pixel as
+/// splatting passes).
+fn render_method(scene: &Scene, method: Method, passes: u32, threads: Option<usize>) -> Rendered {
     let o = Overrides {
-        method: Some(Method::Sppm),
+        method: Some(method),
         passes: Some(passes),
+        spp: (method == Method::PathSplat).then_some(passes),
+        splat_photons: Some(20_000),
         ..Overrides::default()
     };
     let settings = Settings::new(scene, &o).unwrap_or_else(|e| panic!("{e}"));
@@ -290,6 +298,57 @@ fn sppm_snapshots_are_shorter_runs_and_threads_change_no_bit() {
             .flatten()
             .all(|c| c.is_finite() && *c >= 0.0)
     );
+}
+
+#[test]
+fn every_progressive_method_snapshots_what_a_shorter_run_makes() {
+    // Snapshots at 1, 2, 4 and 8 passes (path: samples per pixel; path+splat: path-traced
+    // samples, with as many splatting passes), the one at 4 the image of a 4-pass run on
+    // another thread count, bit for bit.
+    let scene = scene_with("cornell-spheres/analytic.toml", 5, 24, "photons = 20000\n");
+    let bits = |img: &film::Image| -> Vec<[u32; 3]> {
+        img.data.iter().map(|p| p.map(f32::to_bits)).collect()
+    };
+    for method in [Method::Path, Method::CausticSplat, Method::PathSplat] {
+        let long = render_method(&scene, method, 8, Some(2));
+        let short = render_method(&scene, method, 4, Some(1));
+        let passes: Vec<u32> = long.snapshots.iter().map(|s| s.passes).collect();
+        assert_eq!(passes, [1, 2, 4, 8], "{method}");
+        assert!(
+            bits(&image(&long, Some(4))) == bits(&image(&short, None)),
+            "{method}: the snapshot at 4 passes is not the 4-pass run"
+        );
+        assert!(
+            bits(&image(&long, Some(8))) == bits(&image(&long, None)),
+            "{method}"
+        );
+        for snap in &long.snapshots {
+            assert!(snap.seconds >= 0.0 && snap.seconds.is_finite());
+        }
+    }
+}
+
+#[test]
+fn a_time_budget_stops_the_path_tracer_after_the_pass_that_reaches_it() {
+    let scene = scene_with("furnace/furnace.toml", 1, 16, "photons = 1000\n");
+    let o = Overrides {
+        method: Some(Method::Path),
+        passes: Some(4096),
+        time: Some(1e-9),
+        ..Overrides::default()
+    };
+    let settings = Settings::new(&scene, &o).unwrap_or_else(|e| panic!("{e}"));
+    let run = Run {
+        scene: &scene,
+        settings: &settings,
+        cache: Path::new("/nonexistent/photonflow-it-sppm-cache"),
+        photons: Photons::TraceOrReuse,
+        threads: None,
+    };
+    let r = pipeline::methods::render(&run, &|_| {}).unwrap_or_else(|e| panic!("{e}"));
+    // 4096 samples in at most 64 passes: one pass of 64 samples, recorded as the spp made.
+    assert_eq!(r.samples, Some(64));
+    assert!(r.layers.iter().all(|l| l.count == 64));
 }
 
 #[test]

@@ -16,7 +16,7 @@
 //!   heuristic (Veach 1997 ch. 9). Shadow rays are blocked by glass and mirrors, so NEE never
 //!   produces caustics; a light reached by BSDF sampling through one or more specular bounces
 //!   after a diffuse vertex is therefore a caustic with MIS weight 1.
-//! - Pixel sample `s` of pixel `p` draws from `Rng::for_index(seed, p * spp + s)`, tiles
+//! - Pixel sample `s` of pixel `p` draws from `Rng::for_index(seed, s * pixels + p)`, tiles
 //!   accumulate in private f64 buffers merged in tile order, so the film is bit-identical for
 //!   any thread count (pbrt-v4 indexes samples by pixel and sample number the same way).
 //! - Sampling takes its random numbers as arguments (`scene::LightTable::sample`); only the

@@ -11,6 +11,10 @@ use scene::Scene;
 pub struct RenderOptions {
     /// Samples per pixel (box-filtered, jittered within the pixel).
     pub spp: u32,
+    /// Index of the first sample: a progressive run renders samples `first_sample ..
+    /// first_sample + spp` of each pixel per pass, the same samples one run of all of them
+    /// draws.
+    pub first_sample: u32,
     /// Include the paths photon splatting owns at first eye vertices (`L S+ D S* E`, the
     /// `caustic` layer); see [`PathOptions::caustics`].
     pub caustics: bool,
@@ -29,6 +33,7 @@ impl RenderOptions {
         let r = scene.render();
         RenderOptions {
             spp: r.spp,
+            first_sample: 0,
             caustics: true,
             caustic_indirect: true,
             threads: None,
@@ -42,7 +47,7 @@ impl RenderOptions {
 /// sample count as weight): resolve with `Normalize::Constant(spp)` (or `Normalize::Weight`).
 ///
 /// The film is bit-identical for any `threads` and `tile`: pixel sample `s` of pixel
-/// `p = y * width + x` uses `Rng::for_index(scene.seed(), p * spp + s)`, each pixel's samples
+/// `p = y * width + x` uses `Rng::for_index(scene.seed(), s * pixels + p)`, each pixel's samples
 /// are summed in order in one tile buffer, and each pixel receives exactly one merge.
 ///
 /// `progress` is called once per finished tile with the number of samples that tile took
@@ -67,7 +72,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) + Syn
 }
 
 /// The tile machinery shared by every eye-pass method: one film layer per entry of `names`,
-/// pixel sample `s` of pixel `p` drawing from `Rng::for_index(seed, p * spp + s)` (after two
+/// pixel sample `s` of pixel `p` drawing from `Rng::for_index(seed, s * pixels + p)` (after two
 /// numbers for the pixel jitter), `sample` returning one contribution per layer.
 pub(crate) fn render_layers<const N: usize>(
     scene: &Scene,
@@ -89,7 +94,7 @@ pub(crate) fn render_layers<const N: usize>(
         rects
             .par_iter()
             .map(|&rect| {
-                let buf = render_tile(scene, &film, rect, opts.spp, names, sample);
+                let buf = render_tile(scene, &film, rect, opts, names, sample);
                 progress(rect.area() as u64 * opts.spp as u64);
                 buf
             })
@@ -115,19 +120,23 @@ fn render_tile<const N: usize>(
     scene: &Scene,
     film: &Film,
     rect: film::Rect,
-    spp: u32,
+    opts: &RenderOptions,
     names: [&str; N],
     sample: &(dyn Fn(geom::Ray, &mut Rng) -> [glam::Vec3; N] + Sync),
 ) -> TileBuffer {
     let seed = scene.seed();
     let width = film.width();
+    // Sample-major indices: sample s of every pixel before sample s + 1 of any, so a pass
+    // of samples draws what the same samples of a longer run draw.
+    let pixels = (width * film.height()) as u64;
+    let (first, spp) = (opts.first_sample as u64, opts.spp as u64);
     let mut buf = film.tile_buffer(rect);
     for y in rect.y0..rect.y1 {
         for x in rect.x0..rect.x1 {
             let pixel = (y * width + x) as u64;
             let mut sums = [glam::DVec3::ZERO; N];
-            for s in 0..spp as u64 {
-                let mut rng = Rng::for_index(seed, pixel * spp as u64 + s);
+            for s in first..first + spp {
+                let mut rng = Rng::for_index(seed, s * pixels + pixel);
                 let [jx, jy] = rng.uniform2();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
                 let l = sample(ray, &mut rng);

@@ -56,7 +56,7 @@ pub fn pass_seed(seed: u64, pass: u64) -> u64 {
 
 /// The eye vertices of every pixel sample, in pixel order, then sample order, then branch
 /// order (reflection before refraction). Pixel sample `s` of pixel `p` draws from
-/// `Rng::for_index(pass_seed(seed, pass), p * spp + s)` after two numbers for its jitter,
+/// `Rng::for_index(pass_seed(seed, pass), s * pixels + p)` after two numbers for its jitter,
 /// like every eye pass, so the list is the same for any thread count.
 pub fn eye_vertices(scene: &Scene, opts: &VertexOptions) -> Vec<EyeVertex> {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
@@ -71,7 +71,7 @@ pub fn eye_vertices(scene: &Scene, opts: &VertexOptions) -> Vec<EyeVertex> {
         for x in 0..w {
             let pixel = (y * w + x) as u64;
             for s in 0..spp as u64 {
-                let mut rng = Rng::for_index(seed, pixel * spp as u64 + s);
+                let mut rng = Rng::for_index(seed, s * (w * h) as u64 + pixel);
                 let [jx, jy] = rng.uniform2();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
                 found.clear();

@@ -61,11 +61,13 @@ pub fn write(
     // A run stopped by a time budget is reproduced by the passes it made.
     let mut settings = settings.clone();
     if let Some(p) = r.passes {
-        if settings.method == scene::Method::Sppm {
-            settings.estimate.sppm.passes = p;
-        } else {
-            settings.estimate.splat.passes = p;
+        match settings.method {
+            scene::Method::Sppm => settings.estimate.sppm.passes = p,
+            _ => settings.estimate.splat.passes = p,
         }
+    }
+    if let Some(n) = r.samples {
+        settings.render.spp = n;
     }
     let settings = &settings;
     let resolved = settings.resolved_scene(scene)?;

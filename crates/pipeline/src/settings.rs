@@ -163,7 +163,8 @@ pub struct Overrides {
     pub gather_cache: Option<usize>,
     /// Whether the path tracer follows caustic paths (`render.caustics`).
     pub caustics: Option<bool>,
-    /// Photon passes of the progressive methods (`[estimate.splat] passes`).
+    /// Passes of the progressive methods: `[estimate.sppm] passes`, `[estimate.splat]
+    /// passes`, or the path tracer's samples per pixel.
     pub passes: Option<u32>,
     /// Caustic paths per splatting pass (`[estimate.splat] photons`).
     pub splat_photons: Option<u64>,
@@ -239,10 +240,11 @@ impl Settings {
             estimate.final_gather.cache = c;
         }
         if let Some(p) = o.passes {
-            if method == Method::Sppm {
-                estimate.sppm.passes = p;
-            } else {
-                estimate.splat.passes = p;
+            match method {
+                Method::Sppm => estimate.sppm.passes = p,
+                // The path tracer's passes are samples per pixel.
+                Method::Path => render.spp = p,
+                _ => estimate.splat.passes = p,
             }
         }
         if let Some(n) = o.splat_photons {

@@ -3,118 +3,161 @@
 //! bounces) by photon differential splatting onto eye vertices, with no photon map (the
 //! course framework's `splat_caustics_map`). `[estimate.splat]` holds its knobs.
 
-use super::{CountKind, Layer, Rendered, Run};
+use super::{CountKind, Layer, Rendered, Run, Snapshot};
 use crate::splat;
 
 /// JSON facts for `image.json`.
 type Facts = serde_json::Map<String, serde_json::Value>;
 
-/// The splatted caustic layers (`caustic`, and `caustic_indirect` when the settings follow
-/// caustic paths past their first diffuse hit), the passes made and the JSON facts.
-pub(super) fn caustic_layers(
-    run: &Run,
-    progress: &(dyn Fn(u64) + Sync),
-) -> Result<(Vec<Layer>, Facts, u32), String> {
-    let s = run.settings;
-    let sp = &s.estimate.splat;
-    let mut params = s.emit.clone();
-    if sp.photons > 0 {
-        params.photons = sp.photons;
+/// The splatted caustic layers being accumulated pass by pass: each pass makes new eye
+/// vertices (new pixel samples) and new photons, so the mean over passes converges in both.
+pub(super) struct Progressive<'a> {
+    run: &'a Run<'a>,
+    params: emit::EmitParams,
+    /// f64 sums per pixel: `caustic`, and `caustic_indirect` when the settings follow
+    /// caustic paths past their first diffuse hit.
+    images: [Vec<glam::DVec3>; 2],
+    pub passes: u32,
+    vertices: usize,
+    max_in_flight: usize,
+    t_vertices: f64,
+    t_splat: f64,
+}
+
+impl<'a> Progressive<'a> {
+    pub(super) fn new(run: &'a Run<'a>) -> Progressive<'a> {
+        let s = run.settings;
+        let mut params = s.emit.clone();
+        if s.estimate.splat.photons > 0 {
+            params.photons = s.estimate.splat.photons;
+        }
+        let pixels = (run.scene.camera.width * run.scene.camera.height) as usize;
+        let indirect = if s.estimate.splat.indirect { pixels } else { 0 };
+        Progressive {
+            run,
+            params,
+            images: [
+                vec![glam::DVec3::ZERO; pixels],
+                vec![glam::DVec3::ZERO; indirect],
+            ],
+            passes: 0,
+            vertices: 0,
+            max_in_flight: 0,
+            t_vertices: 0.0,
+            t_splat: 0.0,
+        }
     }
-    let (w, h) = (
-        run.scene.camera.width as usize,
-        run.scene.camera.height as usize,
-    );
-    let mut images = [vec![glam::DVec3::ZERO; w * h], vec![]];
-    if sp.indirect {
-        images[1] = vec![glam::DVec3::ZERO; w * h];
-    }
-    // Passes until the count, or the time budget once a pass has been made. Each pass makes
-    // new eye vertices (new pixel samples) and new photons, so the mean over passes
-    // converges in both.
-    let t_splat = std::time::Instant::now();
-    let mut t_vertices = 0.0;
-    let mut passes = 0u32;
-    let mut max_in_flight = 0;
-    let mut vertices = 0;
-    while passes < sp.passes {
+
+    /// One more pass.
+    pub(super) fn step(&mut self, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
+        let (run, s) = (self.run, self.run.settings);
+        let sp = &s.estimate.splat;
         let t0 = std::time::Instant::now();
-        let eyes = splat::eye_index(run.scene, sp, s.estimate.spp, passes as u64, run.threads);
-        t_vertices += t0.elapsed().as_secs_f64();
-        vertices += eyes.len();
+        let pass = self.passes as u64;
+        let eyes = splat::eye_index(run.scene, sp, s.estimate.spp, pass, run.threads);
+        self.t_vertices += t0.elapsed().as_secs_f64();
+        self.vertices += eyes.len();
         let splatter = splat::Splatter {
             scene: run.scene,
-            params: &params,
+            params: &self.params,
             settings: sp,
             eyes: &eyes,
         };
-        let stats = splatter.pass(passes as u64, &mut images, run.threads(), progress)?;
-        max_in_flight = max_in_flight.max(stats.max_in_flight);
-        passes += 1;
-        let elapsed = t_splat.elapsed().as_secs_f64();
+        let stats = splatter.pass(pass, &mut self.images, run.threads(), progress)?;
+        self.max_in_flight = self.max_in_flight.max(stats.max_in_flight);
+        self.passes += 1;
+        self.t_splat += t0.elapsed().as_secs_f64();
         if sp.passes > 1 {
             eprintln!(
-                "splat pass {passes}/{}: {:.2} s, {:.3} M photons/s",
+                "splat pass {}/{}: {:.2} s, {:.3} M photons/s",
+                self.passes,
                 sp.passes,
-                elapsed,
-                (passes as u64 * params.photons) as f64 / elapsed / 1e6
+                self.t_splat,
+                (self.passes as u64 * self.params.photons) as f64 / self.t_splat / 1e6
             );
         }
-        if s.time.is_some_and(|t| elapsed >= t) {
+        Ok(())
+    }
+
+    /// The layers so far, each the mean over the passes made.
+    pub(super) fn layers(&self) -> Vec<Layer> {
+        let names: &[&'static str] = if self.images[1].is_empty() {
+            &["caustic"]
+        } else {
+            &["caustic", "caustic_indirect"]
+        };
+        let n = self.passes.max(1) as f64;
+        names
+            .iter()
+            .zip(&self.images)
+            .map(|(&name, sums)| {
+                let pixels: Vec<glam::DVec3> = sums.iter().map(|v| *v / n).collect();
+                Layer {
+                    name: name.into(),
+                    classes: vec![name],
+                    image: splat::to_image(self.run.scene, &pixels),
+                    count: self.passes as u64 * self.params.photons,
+                    count_kind: CountKind::PhotonPaths,
+                }
+            })
+            .collect()
+    }
+
+    /// What `image.json` records of the splat.
+    pub(super) fn facts(&self) -> Facts {
+        let (scene, sp) = (self.run.scene, &self.run.settings.estimate.splat);
+        let mut info = serde_json::Map::new();
+        for (k, v) in [
+            ("splat", serde_json::json!(sp)),
+            ("splat_photons_emitted", self.params.photons.into()),
+            ("eye_vertices", self.vertices.into()),
+            (
+                "splat_indirect_radius",
+                splat::indirect_radius(scene, sp).into(),
+            ),
+            ("splat_max_radius", splat::max_radius(scene, sp).into()),
+            ("splat_passes", self.passes.into()),
+            ("splat_max_chunks_in_flight", self.max_in_flight.into()),
+            ("time_eye_vertices_s", self.t_vertices.into()),
+            ("time_splat_s", self.t_splat.into()),
+            (
+                "splat_photons_per_s",
+                ((self.passes as u64 * self.params.photons) as f64 / self.t_splat).into(),
+            ),
+        ] {
+            info.insert(k.to_string(), v);
+        }
+        info
+    }
+}
+
+/// Passes until the count, or the time budget once a pass has been made; a snapshot after
+/// 1, 2, 4, ... passes and the last.
+pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
+    let sp = &run.settings.estimate.splat;
+    let t0 = std::time::Instant::now();
+    let mut splat = Progressive::new(run);
+    let mut snapshots = Vec::new();
+    while splat.passes < sp.passes {
+        splat.step(progress)?;
+        let elapsed = t0.elapsed().as_secs_f64();
+        if splat.passes.is_power_of_two() || splat.passes == sp.passes {
+            snapshots.push(Snapshot {
+                passes: splat.passes,
+                seconds: elapsed,
+                layers: splat.layers(),
+            });
+        }
+        if run.settings.time.is_some_and(|t| elapsed >= t) {
             break;
         }
     }
-    let seconds = t_splat.elapsed().as_secs_f64();
-    for p in images.iter_mut().flatten() {
-        *p /= passes as f64;
-    }
-    let mut info = serde_json::Map::new();
-    for (k, v) in [
-        ("splat", serde_json::json!(sp)),
-        ("splat_photons_emitted", params.photons.into()),
-        ("eye_vertices", vertices.into()),
-        (
-            "splat_indirect_radius",
-            splat::indirect_radius(run.scene, sp).into(),
-        ),
-        ("splat_max_radius", splat::max_radius(run.scene, sp).into()),
-        ("splat_passes", passes.into()),
-        ("splat_max_chunks_in_flight", max_in_flight.into()),
-        ("time_eye_vertices_s", t_vertices.into()),
-        ("time_splat_s", seconds.into()),
-        (
-            "splat_photons_per_s",
-            ((passes as u64 * params.photons) as f64 / seconds).into(),
-        ),
-    ] {
-        info.insert(k.to_string(), v);
-    }
-    let names: &[&'static str] = if sp.indirect {
-        &["caustic", "caustic_indirect"]
-    } else {
-        &["caustic"]
-    };
-    let layers = names
-        .iter()
-        .zip(&images)
-        .map(|(&name, pixels)| Layer {
-            name: name.into(),
-            classes: vec![name],
-            image: splat::to_image(run.scene, pixels),
-            count: passes as u64 * params.photons,
-            count_kind: CountKind::PhotonPaths,
-        })
-        .collect();
-    Ok((layers, info, passes))
-}
-
-pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
-    let (layers, info, passes) = caustic_layers(run, progress)?;
     Ok(Rendered {
-        layers,
+        layers: splat.layers(),
         plan: None,
-        info,
-        passes: Some(passes),
-        snapshots: Vec::new(),
+        info: splat.facts(),
+        passes: Some(splat.passes),
+        samples: None,
+        snapshots,
     })
 }

@@ -60,6 +60,7 @@ impl Run<'_> {
     pub(crate) fn render_options(&self, spp: u32) -> eye::RenderOptions {
         eye::RenderOptions {
             spp,
+            first_sample: 0,
             caustics: true,
             caustic_indirect: true,
             threads: self.threads,
@@ -89,6 +90,9 @@ pub struct Rendered {
     pub info: serde_json::Map<String, serde_json::Value>,
     /// Photon passes made, for progressive methods (the resolved scene records them).
     pub passes: Option<u32>,
+    /// Path-traced samples per pixel made (recorded as `render.spp`: a time budget may stop
+    /// the path tracer early).
+    pub samples: Option<u32>,
     /// The image after 1, 2, 4, 8, ... passes and the last, for progressive methods: one
     /// run gives an error-against-time series.
     pub snapshots: Vec<Snapshot>,

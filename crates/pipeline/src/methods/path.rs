@@ -1,66 +1,161 @@
 //! `path`: the independent path-traced reference (`eye::render`), `render.spp` samples per
 //! pixel. With `render.caustics` off it leaves out the paths splatting owns: the `caustic`
 //! layer, and `caustic_indirect` too when `[estimate.splat] indirect` is on.
+//!
+//! Progressive: the samples are rendered in passes (at most 64, each a power of two of
+//! samples), pixel sample `s` drawing what it would in one run of all of them, with a
+//! snapshot whenever the samples so far are a power of two; a time budget (`--time`) stops
+//! after the pass that reaches it and records the samples made.
 
-use super::{CountKind, Layer, LayerSpec, Rendered, Run};
+use super::{CountKind, Layer, Rendered, Run, Snapshot};
 use eye::Part;
+use glam::DVec3;
+
+/// Most passes a run is cut into.
+const MAX_PASSES: u32 = 64;
+
+/// A path-traced image being accumulated pass by pass: per layer, f64 sums per pixel.
+pub(super) struct Progressive<'a> {
+    run: &'a Run<'a>,
+    opts: eye::RenderOptions,
+    parts: Vec<Part>,
+    sums: Vec<Vec<DVec3>>,
+    /// Samples per pixel made so far.
+    pub samples: u32,
+}
+
+impl<'a> Progressive<'a> {
+    pub(super) fn new(run: &'a Run<'a>) -> Progressive<'a> {
+        let r = &run.settings.render;
+        let opts = eye::RenderOptions {
+            caustics: r.caustics,
+            caustic_indirect: r.caustics || !run.settings.estimate.splat.indirect,
+            ..run.render_options(r.spp)
+        };
+        let path_opts = eye::PathOptions {
+            caustics: opts.caustics,
+            caustic_indirect: opts.caustic_indirect,
+            ..eye::PathOptions::from_scene(run.scene)
+        };
+        // Each path-traced layer is one class; a layer the caustic switches empty is left
+        // out, so a splatted layer can take its place.
+        let parts: Vec<Part> = Part::ALL
+            .into_iter()
+            .filter(|&p| path_opts.estimates(p))
+            .collect();
+        let pixels = (run.scene.camera.width * run.scene.camera.height) as usize;
+        Progressive {
+            run,
+            opts,
+            sums: vec![vec![DVec3::ZERO; pixels]; parts.len()],
+            parts,
+            samples: 0,
+        }
+    }
+
+    /// Samples per pass for a run of `spp`: a power of two, at most [`MAX_PASSES`] passes.
+    pub(super) fn pass_samples(spp: u32) -> u32 {
+        spp.div_ceil(MAX_PASSES).max(1).next_power_of_two()
+    }
+
+    /// Renders the next `n` samples of every pixel and adds them.
+    pub(super) fn step(&mut self, n: u32, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
+        let opts = eye::RenderOptions {
+            spp: n,
+            first_sample: self.samples,
+            ..self.opts
+        };
+        let film = eye::render(self.run.scene, &opts, progress);
+        let w = self.run.scene.camera.width as usize;
+        for (part, sums) in self.parts.iter().zip(&mut self.sums) {
+            let layer = film
+                .layer(part.name())
+                .ok_or_else(|| format!("the eye pass wrote no `{}` layer", part.name()))?;
+            for (i, s) in sums.iter_mut().enumerate() {
+                *s += DVec3::from_array(layer.sum(i % w, i / w));
+            }
+        }
+        self.samples += n;
+        Ok(())
+    }
+
+    /// What `image.json` records of the path tracer.
+    pub(super) fn facts(
+        &self,
+        seconds: f64,
+        per_pass: u32,
+    ) -> serde_json::Map<String, serde_json::Value> {
+        let r = &self.run.settings.render;
+        let samples = (self.run.scene.camera.width * self.run.scene.camera.height) as u64
+            * self.samples as u64;
+        let mut info = serde_json::Map::new();
+        for (k, v) in [
+            ("spp", serde_json::json!(self.samples)),
+            ("caustics", r.caustics.into()),
+            ("caustic_indirect", self.opts.caustic_indirect.into()),
+            ("max_depth", r.max_depth.into()),
+            ("rr_depth", r.rr_depth.into()),
+            ("samples", samples.into()),
+            ("samples_per_pass", per_pass.into()),
+            ("time_render_s", seconds.into()),
+            ("samples_per_s", (samples as f64 / seconds).into()),
+        ] {
+            info.insert(k.to_string(), v);
+        }
+        info
+    }
+
+    /// The layers so far, each the mean over the samples made.
+    pub(super) fn layers(&self) -> Vec<Layer> {
+        let (w, h) = (
+            self.run.scene.camera.width as usize,
+            self.run.scene.camera.height as usize,
+        );
+        let n = self.samples.max(1) as f64;
+        self.parts
+            .iter()
+            .zip(&self.sums)
+            .map(|(part, sums)| Layer {
+                name: part.name().to_string(),
+                classes: vec![super::CLASSES[*part as usize]],
+                image: film::Image::from_fn(w, h, |x, y| {
+                    (sums[y * w + x] / n).as_vec3().to_array()
+                }),
+                count: self.samples as u64,
+                count_kind: CountKind::Spp,
+            })
+            .collect()
+    }
+}
 
 pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
     let r = &run.settings.render;
-    let opts = eye::RenderOptions {
-        caustics: r.caustics,
-        caustic_indirect: r.caustics || !run.settings.estimate.splat.indirect,
-        ..run.render_options(r.spp)
-    };
-    let path_opts = eye::PathOptions {
-        caustics: opts.caustics,
-        caustic_indirect: opts.caustic_indirect,
-        ..eye::PathOptions::from_scene(run.scene)
-    };
     let t0 = std::time::Instant::now();
-    let film = eye::render(run.scene, &opts, progress);
-    let seconds = t0.elapsed().as_secs_f64();
-    // Each path-traced layer is one class; a layer the caustic switches empty is left out,
-    // so a splatted layer can take its place.
-    let parts: Vec<Part> = Part::ALL
-        .into_iter()
-        .filter(|&p| path_opts.estimates(p))
-        .collect();
-    let specs: Vec<LayerSpec> = parts
-        .iter()
-        .map(|p| {
-            (
-                p.name(),
-                std::slice::from_ref(&super::CLASSES[*p as usize]),
-                r.spp as u64,
-                CountKind::Spp,
-            )
-        })
-        .collect();
-    let layers: Vec<Layer> = super::layers(&film, r.spp, &specs)?;
-    let (w, h) = (
-        run.scene.camera.width as u64,
-        run.scene.camera.height as u64,
-    );
-    let samples = w * h * r.spp as u64;
-    let mut info = serde_json::Map::new();
-    for (k, v) in [
-        ("spp", serde_json::json!(r.spp)),
-        ("caustics", r.caustics.into()),
-        ("caustic_indirect", opts.caustic_indirect.into()),
-        ("max_depth", r.max_depth.into()),
-        ("rr_depth", r.rr_depth.into()),
-        ("samples", samples.into()),
-        ("time_render_s", seconds.into()),
-        ("samples_per_s", (samples as f64 / seconds).into()),
-    ] {
-        info.insert(k.to_string(), v);
+    let mut image = Progressive::new(run);
+    let per_pass = Progressive::pass_samples(r.spp);
+    let mut snapshots = Vec::new();
+    while image.samples < r.spp {
+        image.step(per_pass.min(r.spp - image.samples), progress)?;
+        let elapsed = t0.elapsed().as_secs_f64();
+        let done = image.samples;
+        if done.is_power_of_two() || done == r.spp {
+            snapshots.push(Snapshot {
+                passes: done,
+                seconds: elapsed,
+                layers: image.layers(),
+            });
+        }
+        if run.settings.time.is_some_and(|t| elapsed >= t) {
+            break;
+        }
     }
+    let seconds = t0.elapsed().as_secs_f64();
     Ok(Rendered {
-        layers,
+        layers: image.layers(),
         plan: None,
-        info,
+        info: image.facts(seconds, per_pass),
         passes: None,
-        snapshots: Vec::new(),
+        samples: Some(image.samples),
+        snapshots,
     })
 }

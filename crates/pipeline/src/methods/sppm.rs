@@ -223,6 +223,7 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
         plan: Some(plan),
         info,
         passes: Some(passes),
+        samples: None,
         snapshots,
     })
 }
