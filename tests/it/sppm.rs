@@ -41,7 +41,11 @@ fn render_method(scene: &Scene, method: Method, passes: u32, threads: Option<usi
         splat_photons: Some(20_000),
         ..Overrides::default()
     };
-    let settings = Settings::new(scene, &o).unwrap_or_else(|e| panic!("{e}"));
+    render_with(scene, &o, threads)
+}
+
+fn render_with(scene: &Scene, o: &Overrides, threads: Option<usize>) -> Rendered {
+    let settings = Settings::new(scene, o).unwrap_or_else(|e| panic!("{e}"));
     let run = Run {
         scene,
         settings: &settings,
@@ -329,47 +333,21 @@ fn every_progressive_method_snapshots_what_a_shorter_run_makes() {
 }
 
 #[test]
-fn a_time_budget_stops_the_path_tracer_after_the_pass_that_reaches_it() {
+fn a_time_budget_stops_after_the_pass_that_reaches_it() {
     let scene = scene_with("furnace/furnace.toml", 1, 16, "photons = 1000\n");
-    let o = Overrides {
-        method: Some(Method::Path),
-        passes: Some(4096),
+    let budget = |method, passes| Overrides {
+        method: Some(method),
+        passes: Some(passes),
         time: Some(1e-9),
         ..Overrides::default()
     };
-    let settings = Settings::new(&scene, &o).unwrap_or_else(|e| panic!("{e}"));
-    let run = Run {
-        scene: &scene,
-        settings: &settings,
-        cache: Path::new("/nonexistent/photonflow-it-sppm-cache"),
-        photons: Photons::TraceOrReuse,
-        threads: None,
-    };
-    let r = pipeline::methods::render(&run, &|_| {}).unwrap_or_else(|e| panic!("{e}"));
-    // 4096 samples in at most 64 passes: one pass of 64 samples, recorded as the spp made.
+    // The path tracer: 4096 samples in at most 64 passes, so one pass of 64 samples,
+    // recorded as the spp made.
+    let r = render_with(&scene, &budget(Method::Path, 4096), None);
     assert_eq!(r.samples, Some(64));
     assert!(r.layers.iter().all(|l| l.count == 64));
-}
-
-#[test]
-fn a_time_budget_stops_sppm_after_the_pass_that_reaches_it() {
-    let scene = scene_with("furnace/furnace.toml", 1, 16, "photons = 1000\n");
-    let o = Overrides {
-        method: Some(Method::Sppm),
-        passes: Some(1000),
-        time: Some(1e-9),
-        ..Overrides::default()
-    };
-    let settings = Settings::new(&scene, &o).unwrap_or_else(|e| panic!("{e}"));
-    let run = Run {
-        scene: &scene,
-        settings: &settings,
-        cache: Path::new("/nonexistent/photonflow-it-sppm-cache"),
-        photons: Photons::TraceOrReuse,
-        threads: None,
-    };
-    let r = pipeline::methods::render(&run, &|_| {}).unwrap_or_else(|e| panic!("{e}"));
-    // The budget is spent within the first pass: exactly one is made, and recorded.
+    // SPPM: exactly one pass is made, and recorded.
+    let r = render_with(&scene, &budget(Method::Sppm, 1000), None);
     assert_eq!(r.passes, Some(1));
     assert_eq!(r.snapshots.len(), 1);
 }

@@ -37,6 +37,8 @@ pub enum FilmError {
     },
     /// A metric over zero pixels (empty image or all-false mask) has no value.
     EmptyRegion,
+    /// Bias and variance apart need at least two independent runs.
+    TooFewRuns { runs: usize },
 }
 
 impl fmt::Display for FilmError {
@@ -65,6 +67,10 @@ impl fmt::Display for FilmError {
                 width.saturating_mul(*height)
             ),
             Self::EmptyRegion => write!(f, "metrics over an empty region (no pixels selected)"),
+            Self::TooFewRuns { runs } => write!(
+                f,
+                "bias and variance need at least two independent runs, got {runs}"
+            ),
         }
     }
 }

@@ -15,12 +15,14 @@
 //! - **The caller picks every path**, and writes are atomic (temp file + rename, see
 //!   [`write_atomic`]); failures are [`FilmError`]s naming the file, never panics.
 
+mod bias;
 mod error;
 mod film;
 mod img;
 mod io;
 mod metrics;
 
+pub use bias::{BiasVariance, RegionSums};
 pub use error::FilmError;
 pub use film::{Film, Layer, Normalize, Rect, TileBuffer, tiles};
 pub use img::{Image, composite};

@@ -521,3 +521,63 @@ fn box_downsampling_averages_blocks() {
     assert_eq!(d.get(0, 0), [0.5, 0.5, 5.5]);
     assert_eq!(img.box_downsample(1).data, img.data);
 }
+
+/// Synthetic runs: a grey reference of 0.5; the left half of every run biased by `B`, every
+/// pixel of every run with independent uniform noise of standard deviation `SIGMA`
+/// (splitmix64: `film` has no random numbers of its own). The decomposition recovers both.
+#[test]
+fn bias_and_variance_are_recovered_from_injected_ones() {
+    const B: f64 = 0.05;
+    const SIGMA: f64 = 0.1;
+    const K: usize = 32;
+    let (w, h) = (16, 16);
+    let mut state = 7u64;
+    let mut uniform = || {
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let reference = constant(w, h, 0.5);
+    let runs: Vec<Image> = (0..K)
+        .map(|_| {
+            Image::from_fn(w, h, |x, _| {
+                let bias = if x < w / 2 { B } else { 0.0 };
+                // Uniform on [-a, a] has variance a^2 / 3.
+                let a = SIGMA * 3f64.sqrt();
+                [0, 1, 2].map(|_| (0.5 + bias + a * (2.0 * uniform() - 1.0)) as f32)
+            })
+        })
+        .collect();
+    let refs: Vec<&Image> = runs.iter().collect();
+    let bv = BiasVariance::new(&refs, &reference, false).unwrap();
+    let left = Mask::from_fn(w, h, |x, _| x < w / 2);
+    let right = Mask::from_fn(w, h, |x, _| x >= w / 2);
+    let (l, r) = (
+        bv.region(Some(&left)).unwrap(),
+        bv.region(Some(&right)).unwrap(),
+    );
+    eprintln!("left {l:?}\nright {r:?}");
+    // bias^2: the mean error's square has standard deviation sqrt(4 B^2 s^2/K + 2 s^4/K^2)
+    // per pixel and channel, 1.8e-3 here, so 1.0e-4 over 384 values: 4 of those.
+    assert!((l.bias2 - B * B).abs() < 4e-4, "left bias^2 {}", l.bias2);
+    // Unbiased pixels: the clamp at zero leaves a small positive mean (about 0.4 s^2 / K).
+    assert!(r.bias2 < 0.1 * B * B, "right bias^2 {}", r.bias2);
+    // s^2 has relative standard deviation sqrt(2 / (K - 1)) = 0.25 per value, 1.3% over 384.
+    for s in [&l, &r] {
+        assert!((s.variance / (SIGMA * SIGMA) - 1.0).abs() < 0.06, "{s:?}");
+        // One run's squared error is bias^2 + s^2 exactly wherever the clamp did not act.
+        assert!(s.mse <= s.bias2 + s.variance + 1e-12);
+        assert!((s.mse - s.bias2 - s.variance).abs() < 0.05 * s.mse, "{s:?}");
+    }
+    // The relative weighting divides by ref^2 + 0.01 = 0.26 here.
+    let rel = BiasVariance::new(&refs, &reference, true).unwrap();
+    let rl = rel.region(Some(&left)).unwrap();
+    assert!((rl.bias2 * 0.26 / l.bias2 - 1.0).abs() < 1e-6);
+    // One run is not enough.
+    assert!(matches!(
+        BiasVariance::new(&refs[..1], &reference, false),
+        Err(FilmError::TooFewRuns { runs: 1 })
+    ));
+}
