@@ -2,17 +2,19 @@
 //! pixel. With `render.caustics` off it leaves out the paths splatting owns: the `caustic`
 //! layer, and `caustic_indirect` too when `[estimate.splat] indirect` is on.
 //!
-//! Progressive: the samples are rendered in passes (at most 64, each a power of two of
-//! samples), pixel sample `s` drawing what it would in one run of all of them, with a
-//! snapshot whenever the samples so far are a power of two; a time budget (`--time`) stops
-//! after the pass that reaches it and records the samples made.
+//! Progressive: the samples are rendered in passes of 1, 1, 2, 4, ... samples per pixel, at
+//! most an eighth of the run each (so a pass never takes more than the time already spent,
+//! or an eighth of the run; passes cost a film each, so there are few of them), pixel sample
+//! `s` drawing what it would in one run of all of them, with a snapshot whenever the samples
+//! so far are a power of two; a time budget (`--time`) stops after the pass that reaches it
+//! and records the samples made.
 
 use super::{CountKind, Layer, Rendered, Run, Snapshot};
 use eye::Part;
 use glam::DVec3;
 
-/// Most passes a run is cut into.
-const MAX_PASSES: u32 = 64;
+/// A pass holds at most this share of a run's samples.
+const MIN_PASSES: u32 = 8;
 
 /// A path-traced image being accumulated pass by pass: per layer, f64 sums per pixel.
 pub(super) struct Progressive<'a> {
@@ -53,9 +55,12 @@ impl<'a> Progressive<'a> {
         }
     }
 
-    /// Samples per pass for a run of `spp`: a power of two, at most [`MAX_PASSES`] passes.
-    pub(super) fn pass_samples(spp: u32) -> u32 {
-        spp.div_ceil(MAX_PASSES).max(1).next_power_of_two()
+    /// Samples of the next pass of a run of `spp`: as many as made so far (at least one), at
+    /// most `spp / MIN_PASSES` rounded up to a power of two, so every power of two of
+    /// samples ends a pass.
+    pub(super) fn next_pass(&self, spp: u32) -> u32 {
+        let cap = spp.div_ceil(MIN_PASSES).max(1).next_power_of_two();
+        self.samples.clamp(1, cap).min(spp - self.samples)
     }
 
     /// Renders the next `n` samples of every pixel and adds them.
@@ -83,7 +88,7 @@ impl<'a> Progressive<'a> {
     pub(super) fn facts(
         &self,
         seconds: f64,
-        per_pass: u32,
+        passes: u32,
     ) -> serde_json::Map<String, serde_json::Value> {
         let r = &self.run.settings.render;
         let samples = (self.run.scene.camera.width * self.run.scene.camera.height) as u64
@@ -96,7 +101,7 @@ impl<'a> Progressive<'a> {
             ("max_depth", r.max_depth.into()),
             ("rr_depth", r.rr_depth.into()),
             ("samples", samples.into()),
-            ("samples_per_pass", per_pass.into()),
+            ("path_passes", passes.into()),
             ("time_render_s", seconds.into()),
             ("samples_per_s", (samples as f64 / seconds).into()),
         ] {
@@ -132,10 +137,11 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     let r = &run.settings.render;
     let t0 = std::time::Instant::now();
     let mut image = Progressive::new(run);
-    let per_pass = Progressive::pass_samples(r.spp);
     let mut snapshots = Vec::new();
+    let mut passes = 0;
     while image.samples < r.spp {
-        image.step(per_pass.min(r.spp - image.samples), progress)?;
+        image.step(image.next_pass(r.spp), progress)?;
+        passes += 1;
         let elapsed = t0.elapsed().as_secs_f64();
         let done = image.samples;
         if done.is_power_of_two() || done == r.spp {
@@ -153,7 +159,7 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     Ok(Rendered {
         layers: image.layers(),
         plan: None,
-        info: image.facts(seconds, per_pass),
+        info: image.facts(seconds, passes),
         passes: None,
         samples: Some(image.samples),
         snapshots,

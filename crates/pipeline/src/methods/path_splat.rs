@@ -5,7 +5,7 @@
 //! nothing is counted twice and nothing is missed; they are composited as `composite` would.
 //!
 //! Both run progressively and interleaved: after each path-traced pass, splatting passes
-//! catch up with the same share of theirs, so a snapshot (whenever the path tracer's samples
+//! catch up with the same share of theirs (its share of the samples), so a snapshot (whenever the path tracer's samples
 //! are a power of two) or a time budget finds both about equally far along.
 
 use super::{Rendered, Run, Snapshot, caustic_splat, path};
@@ -19,18 +19,19 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     };
     let spp = settings.render.spp;
     let splat_passes = settings.estimate.splat.passes;
-    let per_pass = path::Progressive::pass_samples(spp);
-    let path_passes = spp.div_ceil(per_pass) as u64;
     let t0 = std::time::Instant::now();
     let mut image = path::Progressive::new(&path_run);
     let mut splat = caustic_splat::Progressive::new(run);
     let mut snapshots = Vec::new();
-    let mut k = 0u64;
+    let mut passes = 0;
     while image.samples < spp {
-        image.step(per_pass.min(spp - image.samples), progress)?;
-        k += 1;
-        // The splat's progress counts photons, not samples: it reports through its own line.
-        let due = (splat_passes as u64 * k).div_ceil(path_passes).max(1) as u32;
+        image.step(image.next_pass(spp), progress)?;
+        passes += 1;
+        // Splatting keeps pace with the path tracer's share of samples made. Its progress
+        // counts photons, not samples: it reports through its own line.
+        let due = (splat_passes as u64 * image.samples as u64)
+            .div_ceil(spp as u64)
+            .max(1) as u32;
         while splat.passes < due {
             splat.step(&|_| {})?;
         }
@@ -52,7 +53,7 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
         }
     }
     let seconds = t0.elapsed().as_secs_f64();
-    let mut info = image.facts(seconds, per_pass);
+    let mut info = image.facts(seconds, passes);
     info.extend(splat.facts());
     let mut layers = image.layers();
     layers.extend(splat.layers());
