@@ -3,6 +3,8 @@
 //!
 //! - `cornell`: ray casting on the worksheet scene as loaded from `scenes/` (BVH = brute force,
 //!   the light under the ceiling is reachable, camera rays behave).
+//! - `evidence`: bias^2 and variance apart from independent runs: zero bias for the path
+//!   tracer, a fixed-k estimate's bias growing with k at the caustic.
 //! - `photons`: photon flux against the path tracer (caustic flux under the glass sphere) and
 //!   against the light power (closed furnace box).
 //! - `photon_maps`: the photon-map methods through the pipeline library, trace to image: the
@@ -15,6 +17,7 @@
 //!   the rate its radius schedule predicts; snapshots, time budget, thread-count invariance.
 
 mod cornell;
+mod evidence;
 mod photon_maps;
 mod photons;
 mod splat;

@@ -23,6 +23,11 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
                       worksheet 7's images (box kernel, Silverman, + topological test,
                       + boundary correction) with errors against a path-traced reference,
                       summarised in out/worksheet/README.md
+  evidence [SCENE] [--quick] [--seeds K] [--reference EXR] [--reference-spp N]
+                      each technique over a ladder of budgets, K seeds each, against a
+                      reference: relMSE (two conventions), RMSE, mean ratio, bias^2 and variance
+                      per region (caustic, edges and corners, glass sphere, open walls);
+                      out/evidence/evidence.md, evidence.json, maps/ (EXR and false colour)
   composite RUN... --out DIR
                       combine runs of one view: layers of one name averaged by their counts,
                       disjoint layers summed (independent runs: other --seed)
@@ -83,8 +88,8 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
         [] | ["help" | "-h" | "--help", ..] => Ok(Cmd::Help),
         ["gen-scenes"] => Ok(Cmd::GenScenes),
         [
-            cmd
-            @ ("info" | "render" | "compare" | "composite" | "trace" | "estimate" | "worksheet"),
+            cmd @ ("info" | "render" | "compare" | "composite" | "trace" | "estimate" | "worksheet"
+            | "evidence"),
             rest @ ..,
         ] => Ok(Cmd::Photonflow(
             std::iter::once(*cmd)

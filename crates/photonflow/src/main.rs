@@ -137,6 +137,29 @@ enum Cmd {
         #[arg(long)]
         threads: Option<usize>,
     },
+    /// What accuracy costs in time, bias and variance apart: each technique over a ladder of
+    /// budgets, `--seeds` independent runs each, against a reference; errors and bias^2 /
+    /// variance per region (from the scene's geometry), maps as EXR and false-colour PNG.
+    Evidence {
+        #[arg(default_value = "scenes/cornell-spheres/analytic.toml")]
+        scene: PathBuf,
+        /// A linear RGB EXR of the same view from any renderer (else a path-traced one,
+        /// rendered once into --out and reused).
+        #[arg(long)]
+        reference: Option<PathBuf>,
+        #[arg(long, default_value_t = 1024)]
+        reference_spp: u32,
+        /// Independent runs (seeds 1..=N) per technique and budget.
+        #[arg(long, default_value_t = 8)]
+        seeds: u32,
+        /// The short ladder: a few minutes on 2 cores.
+        #[arg(long)]
+        quick: bool,
+        #[arg(long, default_value = "out/evidence")]
+        out: PathBuf,
+        #[arg(long)]
+        threads: Option<usize>,
+    },
     /// Trace the photon sets a scene needs into the cache (or reuse them).
     Trace {
         scene: PathBuf,
@@ -435,6 +458,23 @@ fn run(cmd: Cmd) -> Result<(), String> {
                 .collect();
             pipeline::accuracy::accuracy(&scene, reference.as_deref(), reference_spp, &peers, &dir)
         }
+        Cmd::Evidence {
+            scene,
+            reference,
+            reference_spp,
+            seeds,
+            quick,
+            out,
+            threads,
+        } => pipeline::evidence::run(&pipeline::evidence::EvidenceArgs {
+            scene,
+            reference,
+            reference_spp,
+            seeds,
+            quick,
+            out,
+            threads,
+        }),
         Cmd::Worksheet {
             scene,
             photons,

@@ -238,9 +238,11 @@ pub fn render_image(
     Ok((img, r))
 }
 
-/// Renders one rung with seeds `1..=seeds` and decomposes its error.
+/// Renders one rung with seeds `1..=seeds` (`scene(seed)` makes the scene of each) and
+/// decomposes its error.
+#[allow(clippy::too_many_arguments)]
 pub fn rung(
-    path: &Path,
+    scene: &dyn Fn(u64) -> Result<Scene, String>,
     t: &Technique,
     amount: u64,
     seeds: u32,
@@ -253,7 +255,7 @@ pub fn rung(
     let mut images = Vec::new();
     let mut seconds = 0.0;
     for seed in 1..=seeds as u64 {
-        let scene = Scene::load_with(path, |f| f.seed = seed).map_err(|e| e.to_string())?;
+        let scene = scene(seed)?;
         // Each run traces its own photons: the seed changes them, and the time counts them.
         let _ = std::fs::remove_dir_all(cache);
         let t0 = Instant::now();
@@ -274,7 +276,11 @@ pub fn rung(
             e.rmse += x.rmse / images.len() as f64;
             e.mean_ratio += x.mean_ratio / images.len() as f64;
         }
-        out.push((*name, e, maps.region(Some(mask)).map_err(|e| e.to_string())?));
+        out.push((
+            *name,
+            e,
+            maps.region(Some(mask)).map_err(|e| e.to_string())?,
+        ));
     }
     Ok(RungResult {
         technique: t.name,
@@ -297,7 +303,11 @@ fn reference(scene: &Scene, a: &EvidenceArgs) -> Result<Image, String> {
             ));
             let exr = dir.join("image.exr");
             if !exr.is_file() {
-                println!("reference: path tracing {} spp into {}", a.reference_spp, dir.display());
+                println!(
+                    "reference: path tracing {} spp into {}",
+                    a.reference_spp,
+                    dir.display()
+                );
                 crate::render(
                     scene,
                     &crate::RenderRequest {
@@ -334,7 +344,10 @@ fn reference(scene: &Scene, a: &EvidenceArgs) -> Result<Image, String> {
 
 pub fn run(a: &EvidenceArgs) -> Result<(), String> {
     if a.seeds < 2 {
-        return Err(format!("--seeds {} must be at least 2 (bias and variance need two runs)", a.seeds));
+        return Err(format!(
+            "--seeds {} must be at least 2 (bias and variance need two runs)",
+            a.seeds
+        ));
     }
     let scene = Scene::load(&a.scene).map_err(|e| e.to_string())?;
     std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
@@ -351,27 +364,39 @@ pub fn run(a: &EvidenceArgs) -> Result<(), String> {
         a.scene.display(),
         a.seeds,
         a.seeds,
-        a.reference
-            .as_ref()
-            .map_or(format!("a {}-spp path-traced reference", a.reference_spp), |p| p
-                .display()
-                .to_string())
+        a.reference.as_ref().map_or(
+            format!("a {}-spp path-traced reference", a.reference_spp),
+            |p| p.display().to_string()
+        )
     );
     let _ = writeln!(
         md,
         "| technique | budget | time (s) | region | relMSE | relMSE pbrt | RMSE | mean / ref | bias^2 | variance |\n|---|---|---|---|---|---|---|---|---|---|"
     );
     let mut json = Vec::new();
+    let make = |seed: u64| Scene::load_with(&a.scene, |f| f.seed = seed).map_err(|e| e.to_string());
     for t in techniques(a.quick) {
         for &amount in &t.ladder {
-            let r = rung(&a.scene, &t, amount, a.seeds, &reference, &regions, &cache, a.threads)?;
+            let r = rung(
+                &make, &t, amount, a.seeds, &reference, &regions, &cache, a.threads,
+            )?;
             let label = format!("{} {}", r.amount, r.budget.name());
-            println!("{:<64} {label:>22} {:8.2} s  relMSE {:.5}", r.technique, r.seconds, r.regions[0].1.relmse);
+            println!(
+                "{:<64} {label:>22} {:8.2} s  relMSE {:.5}",
+                r.technique, r.seconds, r.regions[0].1.relmse
+            );
             for (region, e, s) in &r.regions {
                 let _ = writeln!(
                     md,
                     "| {} | {label} | {:.2} | {region} | {:.5} | {:.5} | {:.5} | {:.4} | {:.5} | {:.5} |",
-                    r.technique, r.seconds, e.relmse, e.relmse_pbrt, e.rmse, e.mean_ratio, s.bias2, s.variance
+                    r.technique,
+                    r.seconds,
+                    e.relmse,
+                    e.relmse_pbrt,
+                    e.rmse,
+                    e.mean_ratio,
+                    s.bias2,
+                    s.variance
                 );
                 json.push(serde_json::json!({
                     "technique": r.technique, "budget": r.budget.name(), "amount": r.amount,
@@ -383,9 +408,18 @@ pub fn run(a: &EvidenceArgs) -> Result<(), String> {
             }
             // Maps of each rung: EXR (linear) and false colour (square-root scale up to the
             // rung's 99th percentile of bias^2 + variance).
-            let dir = a.out.join("maps").join(slug(&format!("{}-{}", r.technique, r.amount)));
+            let dir = a
+                .out
+                .join("maps")
+                .join(slug(&format!("{}-{}", r.technique, r.amount)));
             std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-            let mut both: Vec<f64> = r.maps.bias2.iter().zip(&r.maps.variance).map(|(b, v)| b + v).collect();
+            let mut both: Vec<f64> = r
+                .maps
+                .bias2
+                .iter()
+                .zip(&r.maps.variance)
+                .map(|(b, v)| b + v)
+                .collect();
             both.sort_by(f64::total_cmp);
             let top = both[(both.len() * 99 / 100).min(both.len() - 1)];
             for (name, map) in [("bias2", &r.maps.bias2), ("variance", &r.maps.variance)] {
@@ -394,7 +428,10 @@ pub fn run(a: &EvidenceArgs) -> Result<(), String> {
                 film::write_png(
                     dir.join(format!("{name}.png")),
                     &r.maps.false_colour(map, top),
-                    &film::ToneMap { gamma: 1.0, exposure: 0.0 },
+                    &film::ToneMap {
+                        gamma: 1.0,
+                        exposure: 0.0,
+                    },
                 )
                 .map_err(|e| e.to_string())?;
             }
@@ -404,13 +441,22 @@ pub fn run(a: &EvidenceArgs) -> Result<(), String> {
     film::write_atomic(&a.out.join("evidence.md"), md.as_bytes()).map_err(|e| e.to_string())?;
     let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
     film::write_atomic(&a.out.join("evidence.json"), text.as_bytes()).map_err(|e| e.to_string())?;
-    println!("wrote {} (table), evidence.json and maps/", a.out.join("evidence.md").display());
+    println!(
+        "wrote {} (table), evidence.json and maps/",
+        a.out.join("evidence.md").display()
+    );
     Ok(())
 }
 
 fn slug(s: &str) -> String {
     s.chars()
-        .map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '-' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '-'
+            }
+        })
         .collect::<String>()
         .split('-')
         .filter(|p| !p.is_empty())

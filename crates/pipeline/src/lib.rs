@@ -20,6 +20,7 @@
 pub mod accuracy;
 pub mod bench;
 pub mod boundary;
+pub mod evidence;
 pub mod flow;
 pub mod gather_cache;
 pub mod maps;
