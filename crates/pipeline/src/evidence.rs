@@ -438,6 +438,7 @@ pub fn run(a: &EvidenceArgs) -> Result<(), String> {
             film::write_exr(dir.join("mean.exr"), &r.maps.mean).map_err(|e| e.to_string())?;
         }
     }
+    k_sweep(a, &make, &reference, &regions, &cache, &mut md, &mut json)?;
     film::write_atomic(&a.out.join("evidence.md"), md.as_bytes()).map_err(|e| e.to_string())?;
     let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
     film::write_atomic(&a.out.join("evidence.json"), text.as_bytes()).map_err(|e| e.to_string())?;
@@ -445,6 +446,103 @@ pub fn run(a: &EvidenceArgs) -> Result<(), String> {
         "wrote {} (table), evidence.json and maps/",
         a.out.join("evidence.md").display()
     );
+    Ok(())
+}
+
+/// The worksheet's trade-off itself: the global map shown directly, k swept for each kernel,
+/// with and without the topological test and boundary correction, at a fixed photon count
+/// (bias^2 rises and variance falls with k); then photons and k grown together (`photons /
+/// k` fixed, so the disc keeps its size: the bias stays, the noise falls; each rung's time is
+/// in evidence.json).
+fn k_sweep(
+    a: &EvidenceArgs,
+    make: &dyn Fn(u64) -> Result<Scene, String>,
+    reference: &Image,
+    regions: &[(&'static str, Mask)],
+    cache: &Path,
+    md: &mut String,
+    json: &mut Vec<serde_json::Value>,
+) -> Result<(), String> {
+    let ks: &[usize] = if a.quick {
+        &[50, 250, 1000]
+    } else {
+        &[50, 100, 250, 500, 1000, 2000]
+    };
+    let photons = 200_000u64;
+    let variants: [(&str, Kernel, Option<f32>, bool); 4] = [
+        ("box", Kernel::Uniform, None, false),
+        ("Silverman", Kernel::Silverman, None, false),
+        (
+            "Silverman + topological test",
+            Kernel::Silverman,
+            Some(0.1),
+            false,
+        ),
+        (
+            "Silverman + topological test + boundary",
+            Kernel::Silverman,
+            Some(0.1),
+            true,
+        ),
+    ];
+    let _ = writeln!(
+        md,
+        "\n## The global map's k against bias and variance ({photons} photon paths)\n\n\
+         | kernel | k | region | bias^2 | variance | relMSE |\n|---|---|---|---|---|---|"
+    );
+    let mut sweep = |md: &mut String, label: String, o: Overrides, amount: u64| {
+        let t = Technique {
+            name: "global map",
+            overrides: o,
+            budget: Budget::Photons,
+            ladder: vec![amount],
+        };
+        let r = rung(
+            make, &t, amount, a.seeds, reference, regions, cache, a.threads,
+        )?;
+        println!("k sweep {label:<58} relMSE {:.5}", r.regions[0].1.relmse);
+        for (region, e, s) in &r.regions {
+            let _ = writeln!(
+                md,
+                "| {label} | {region} | {:.5} | {:.5} | {:.5} |",
+                s.bias2, s.variance, e.relmse
+            );
+            json.push(serde_json::json!({
+                "sweep": label, "photons": amount, "region": region, "seconds": r.seconds,
+                "mean_ratio": e.mean_ratio,
+                "bias2": s.bias2, "variance": s.variance, "relmse": e.relmse,
+            }));
+        }
+        Ok::<(), String>(())
+    };
+    for (name, kernel, topo, boundary) in variants {
+        for &k in ks {
+            let o = Overrides {
+                method: Some(Method::GlobalDirect),
+                k: Some(k),
+                kernel: Some(kernel),
+                topo: Some(topo),
+                boundary: Some(boundary),
+                ..Overrides::default()
+            };
+            sweep(md, format!("{name} | {k}"), o, photons)?;
+        }
+    }
+    let _ = writeln!(
+        md,
+        "\n## Photons and k grown together (Silverman, photons / k = 200)\n\n\
+         | kernel | k | region | bias^2 | variance | relMSE |\n|---|---|---|---|---|---|"
+    );
+    for &k in ks {
+        let o = Overrides {
+            method: Some(Method::GlobalDirect),
+            k: Some(k),
+            kernel: Some(Kernel::Silverman),
+            ..Overrides::default()
+        };
+        let label = format!("Silverman, {} paths | {k}", 200 * k);
+        sweep(md, label, o, 200 * k as u64)?;
+    }
     Ok(())
 }
 
