@@ -6,7 +6,7 @@
 use glam::DVec3;
 use math::analytic::polygon_irradiance;
 use pipeline::methods::CountKind;
-use pipeline::{Overrides, Photons, Rendered, Run, Settings};
+use pipeline::{Overrides, Rendered};
 use scene::{Method, Scene};
 use std::path::Path;
 use tests::scenes_dir;
@@ -44,21 +44,17 @@ fn render_method(scene: &Scene, method: Method, passes: u32, threads: Option<usi
     render_with(scene, &o, threads)
 }
 
+/// What the method `o` names renders (these methods read no photon cache).
 fn render_with(scene: &Scene, o: &Overrides, threads: Option<usize>) -> Rendered {
-    let settings = Settings::new(scene, o).unwrap_or_else(|e| panic!("{e}"));
-    let run = Run {
-        scene,
-        settings: &settings,
-        cache: Path::new("/nonexistent/photonflow-it-sppm-cache"),
-        photons: Photons::TraceOrReuse,
-        threads,
-    };
-    pipeline::methods::render(&run, &|_| {}).unwrap_or_else(|e| panic!("{e}"))
+    let cache = Path::new("/nonexistent/photonflow-it-sppm-cache");
+    pipeline::evidence::render_image(scene, o, cache, threads)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .1
 }
 
-/// The image of a snapshot (or of the run, `passes = None`): the sum of its layers.
-fn image(r: &Rendered, passes: Option<u32>) -> film::Image {
-    let layers = match passes {
+/// The layers of a snapshot (or of the run, `passes = None`).
+fn layers_at(r: &Rendered, passes: Option<u32>) -> &[pipeline::methods::Layer] {
+    match passes {
         None => &r.layers,
         Some(p) => {
             &r.snapshots
@@ -67,8 +63,15 @@ fn image(r: &Rendered, passes: Option<u32>) -> film::Image {
                 .unwrap_or_else(|| panic!("no snapshot at {p} passes"))
                 .layers
         }
-    };
-    let parts: Vec<(&film::Image, f32)> = layers.iter().map(|l| (&l.image, 1.0)).collect();
+    }
+}
+
+/// The image of a snapshot (or of the run): the sum of its layers.
+fn image(r: &Rendered, passes: Option<u32>) -> film::Image {
+    let parts: Vec<(&film::Image, f32)> = layers_at(r, passes)
+        .iter()
+        .map(|l| (&l.image, 1.0))
+        .collect();
     film::composite(&parts).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -77,19 +80,9 @@ fn pixel(img: &film::Image, (x, y): (usize, usize)) -> f64 {
     img.get(x, y).iter().map(|&c| c as f64).sum::<f64>() / 3.0
 }
 
-/// One layer of a snapshot (or of the run, `passes = None`).
+/// One layer of a snapshot (or of the run).
 fn layer(r: &Rendered, passes: Option<u32>, name: &str) -> film::Image {
-    let layers = match passes {
-        None => &r.layers,
-        Some(p) => {
-            &r.snapshots
-                .iter()
-                .find(|s| s.passes == p)
-                .unwrap_or_else(|| panic!("no snapshot at {p} passes"))
-                .layers
-        }
-    };
-    layers
+    layers_at(r, passes)
         .iter()
         .find(|l| l.name == name)
         .unwrap_or_else(|| panic!("no layer {name}"))
@@ -326,9 +319,6 @@ fn every_progressive_method_snapshots_what_a_shorter_run_makes() {
             bits(&image(&long, Some(8))) == bits(&image(&long, None)),
             "{method}"
         );
-        for snap in &long.snapshots {
-            assert!(snap.seconds >= 0.0 && snap.seconds.is_finite());
-        }
     }
 }
 

@@ -30,7 +30,7 @@ mod visible;
 
 pub use path::{Part, PathOptions, PathTracer, Radiance};
 pub use photon::{Irradiance, MapLookup, render_final_gather, render_global_direct};
-pub use render::{RenderOptions, render};
+pub use render::{RenderOptions, on_threads, render};
 pub use vertices::{EyeVertex, VertexOptions, eye_vertices, pass_seed};
 pub use visible::{PixelSample, VisiblePoint, visible_points};
 

@@ -100,14 +100,7 @@ pub(crate) fn render_layers<const N: usize>(
             })
             .collect()
     };
-    let buffers = match opts.threads {
-        Some(n) => match rayon::ThreadPoolBuilder::new().num_threads(n).build() {
-            Ok(pool) => pool.install(work),
-            // No pool (resource limits): the global one gives the same image.
-            Err(_) => work(),
-        },
-        None => work(),
-    };
+    let buffers = on_threads(opts.threads, work);
     // `collect` keeps tile order; merging in that order is deterministic (and, since tiles
     // partition the image, the order would not matter anyway).
     for buf in &buffers {
@@ -152,4 +145,13 @@ fn render_tile<const N: usize>(
         }
     }
     buf
+}
+
+/// Runs `work` on a pool of `threads` workers (`None`, or no pool to be had under resource
+/// limits: rayon's global pool). Every eye pass's result is the same for any pool.
+pub fn on_threads<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> T {
+    match threads.and_then(|n| rayon::ThreadPoolBuilder::new().num_threads(n).build().ok()) {
+        Some(pool) => pool.install(work),
+        None => work(),
+    }
 }

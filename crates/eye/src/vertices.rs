@@ -96,13 +96,7 @@ pub fn eye_vertices(scene: &Scene, opts: &VertexOptions) -> Vec<EyeVertex> {
         out
     };
     let work = || -> Vec<EyeVertex> { (0..h).into_par_iter().flat_map_iter(row).collect() };
-    match opts.threads {
-        Some(n) => match rayon::ThreadPoolBuilder::new().num_threads(n).build() {
-            Ok(pool) => pool.install(work),
-            Err(_) => work(),
-        },
-        None => work(),
-    }
+    crate::render::on_threads(opts.threads, work)
 }
 
 /// A first diffuse vertex as the eye passes use it.

@@ -75,15 +75,5 @@ pub fn visible_points(
             .collect()
     };
     let work = || -> Vec<PixelSample> { (0..h).into_par_iter().flat_map_iter(row).collect() };
-    match opts_pool(threads) {
-        Some(pool) => pool.install(work),
-        None => work(),
-    }
-}
-
-fn opts_pool(threads: Option<usize>) -> Option<rayon::ThreadPool> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads?)
-        .build()
-        .ok()
+    crate::render::on_threads(threads, work)
 }

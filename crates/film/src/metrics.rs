@@ -62,6 +62,9 @@ pub struct Metrics {
     pub rmse: f64,
     /// `mean((a - b)² / (b² + RELMSE_EPSILON))`.
     pub relmse: f64,
+    /// pbrt's convention, `mean((a - b)² / (b + 0.01)²)`: the same idea, weighted more
+    /// heavily in dark pixels (so the two are named apart).
+    pub relmse_pbrt: f64,
     /// `mean(|a - b|)`.
     pub mae: f64,
     /// Mean channel value of `a` (compare with `mean_b` for bias).
@@ -76,8 +79,15 @@ impl fmt::Display for Metrics {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "rmse={:.6e} relmse={:.6e} mae={:.6e} mean_a={:.6e} mean_b={:.6e} pixels={}",
-            self.rmse, self.relmse, self.mae, self.mean_a, self.mean_b, self.pixels
+            "rmse={:.6e} relmse={:.6e} relmse_pbrt={:.6e} mae={:.6e} mean_a={:.6e} mean_b={:.6e} \
+             pixels={}",
+            self.rmse,
+            self.relmse,
+            self.relmse_pbrt,
+            self.mae,
+            self.mean_a,
+            self.mean_b,
+            self.pixels
         )
     }
 }
@@ -107,6 +117,7 @@ pub fn metrics(a: &Image, b: &Image, mask: Option<&Mask>) -> Result<Metrics, Fil
     }
     let selected = |i: usize| mask.is_none_or(|m| m.pixels[i]);
     let (mut se, mut rel, mut ae, mut sa, mut sb) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let mut pbrt = 0.0f64;
     let mut pixels = 0usize;
     for (i, (pa, pb)) in a.data.iter().zip(&b.data).enumerate() {
         if !selected(i) {
@@ -118,6 +129,7 @@ pub fn metrics(a: &Image, b: &Image, mask: Option<&Mask>) -> Result<Metrics, Fil
             let d = x - y;
             se += d * d;
             rel += d * d / (y * y + RELMSE_EPSILON);
+            pbrt += d * d / ((y + 0.01) * (y + 0.01));
             ae += d.abs();
             sa += x;
             sb += y;
@@ -130,6 +142,7 @@ pub fn metrics(a: &Image, b: &Image, mask: Option<&Mask>) -> Result<Metrics, Fil
     Ok(Metrics {
         rmse: (se / n).sqrt(),
         relmse: rel / n,
+        relmse_pbrt: pbrt / n,
         mae: ae / n,
         mean_a: sa / n,
         mean_b: sb / n,

@@ -27,6 +27,8 @@ fn metrics_of_constant_images_match_hand_values() {
     assert!(close(m.mae, 0.5), "{m}");
     // (1 - 0.5)² / (0.5² + 0.01) = 0.25 / 0.26
     assert!(close(m.relmse, 0.25 / 0.26), "{m}");
+    // pbrt's convention: 0.25 / (0.5 + 0.01)²
+    assert!(close(m.relmse_pbrt, 0.25 / (0.51 * 0.51)), "{m}");
     assert!(close(m.mean_a, 1.0) && close(m.mean_b, 0.5), "{m}");
     assert_eq!(m.pixels, 12);
     let line = m.to_string();

@@ -57,9 +57,14 @@ fn time_to(target: f64, rungs: &[Rung]) -> Option<f64> {
     None
 }
 
-/// The reference: `given`, or a `spp`-sample path-traced image of the scene cached under
-/// `dir` by the scene's view hash and seed (rendered once).
-fn reference(scene: &Scene, given: Option<&Path>, spp: u32, dir: &Path) -> Result<PathBuf, String> {
+/// The reference of `bench accuracy` and `evidence`: `given`, or a `spp`-sample path-traced
+/// image of the scene cached under `dir` by the scene's view hash (rendered once).
+pub(crate) fn reference(
+    scene: &Scene,
+    given: Option<&Path>,
+    spp: u32,
+    dir: &Path,
+) -> Result<PathBuf, String> {
     if let Some(p) = given {
         return Ok(p.to_path_buf());
     }

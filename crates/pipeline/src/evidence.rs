@@ -9,7 +9,7 @@
 use crate::methods::{Photons, Rendered, Run};
 use crate::{Overrides, Settings, worksheet};
 use density::Kernel;
-use film::{BiasVariance, Image, Mask, RELMSE_EPSILON};
+use film::{BiasVariance, Image, Mask};
 use scene::{Material, Method, Scene};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -169,41 +169,15 @@ pub fn regions(scene: &Scene) -> Vec<(&'static str, Mask)> {
     ]
 }
 
-/// Errors of one image against the reference over a mask: relative MSE as
-/// `(v - r)² / (r² + 0.01)` and as pbrt's `(v - r)² / (r + 0.01)²`, RMSE, and the ratio of
-/// the means.
+/// Mean errors of a rung's runs over one region: relative MSE as `(v - r)² / (r² + 0.01)`
+/// and as pbrt's `(v - r)² / (r + 0.01)²`, RMSE, and the ratio of the means
+/// (`film::metrics` of each run, averaged).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Errors {
     pub relmse: f64,
     pub relmse_pbrt: f64,
     pub rmse: f64,
     pub mean_ratio: f64,
-}
-
-pub fn errors(img: &Image, reference: &Image, mask: &Mask) -> Errors {
-    let (mut rel, mut pbrt, mut sq, mut a, mut b, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    for (i, (p, q)) in img.data.iter().zip(&reference.data).enumerate() {
-        if !mask.pixels[i] {
-            continue;
-        }
-        for c in 0..3 {
-            let (v, r) = (p[c] as f64, q[c] as f64);
-            let d2 = (v - r) * (v - r);
-            rel += d2 / (r * r + RELMSE_EPSILON);
-            pbrt += d2 / ((r + 0.01) * (r + 0.01));
-            sq += d2;
-            a += v;
-            b += r;
-            n += 1.0;
-        }
-    }
-    let n = f64::max(n, 1.0);
-    Errors {
-        relmse: rel / n,
-        relmse_pbrt: pbrt / n,
-        rmse: (sq / n).sqrt(),
-        mean_ratio: if b > 0.0 { a / b } else { f64::NAN },
-    }
 }
 
 /// One rung's result: its mean time and, per region, the mean errors over the runs and the
@@ -267,20 +241,22 @@ pub fn rung(
     let runs: Vec<&Image> = images.iter().collect();
     let maps = BiasVariance::new(&runs, reference, true).map_err(|e| e.to_string())?;
     let mut out = Vec::new();
+    let k = images.len() as f64;
     for (name, mask) in regions {
+        // A region the scene does not have (no glass, say) has no errors.
+        if mask.count() == 0 {
+            continue;
+        }
         let mut e = Errors::default();
         for img in &images {
-            let x = errors(img, reference, mask);
-            e.relmse += x.relmse / images.len() as f64;
-            e.relmse_pbrt += x.relmse_pbrt / images.len() as f64;
-            e.rmse += x.rmse / images.len() as f64;
-            e.mean_ratio += x.mean_ratio / images.len() as f64;
+            let m = film::metrics(img, reference, Some(mask)).map_err(|e| e.to_string())?;
+            e.relmse += m.relmse / k;
+            e.relmse_pbrt += m.relmse_pbrt / k;
+            e.rmse += m.rmse / k;
+            e.mean_ratio += m.mean_a / m.mean_b / k;
         }
-        out.push((
-            *name,
-            e,
-            maps.region(Some(mask)).map_err(|e| e.to_string())?,
-        ));
+        let sums = maps.region(Some(mask)).map_err(|e| e.to_string())?;
+        out.push((*name, e, sums));
     }
     Ok(RungResult {
         technique: t.name,
@@ -292,43 +268,10 @@ pub fn rung(
     })
 }
 
-/// The reference: the given EXR, or a path-traced one cached in `out` by view hash and spp.
+/// The reference (`accuracy::reference`: given, or path-traced once and cached in `out`),
+/// read and checked against the scene's size.
 fn reference(scene: &Scene, a: &EvidenceArgs) -> Result<Image, String> {
-    let path = match &a.reference {
-        Some(p) => p.clone(),
-        None => {
-            let dir = a.out.join(format!(
-                "reference-{:016x}-{}spp",
-                scene.view_hash, a.reference_spp
-            ));
-            let exr = dir.join("image.exr");
-            if !exr.is_file() {
-                println!(
-                    "reference: path tracing {} spp into {}",
-                    a.reference_spp,
-                    dir.display()
-                );
-                crate::render(
-                    scene,
-                    &crate::RenderRequest {
-                        overrides: Overrides {
-                            method: Some(Method::Path),
-                            spp: Some(a.reference_spp),
-                            ..Overrides::default()
-                        },
-                        cache: &a.out.join("cache"),
-                        photons: Photons::TraceOrReuse,
-                        threads: a.threads,
-                        out: Some(dir),
-                        exposure: 0.0,
-                        reference: None,
-                        label: None,
-                    },
-                )?;
-            }
-            exr
-        }
-    };
+    let path = crate::accuracy::reference(scene, a.reference.as_deref(), a.reference_spp, &a.out)?;
     let img = film::read_exr(&path).map_err(|e| e.to_string())?;
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     if (img.width, img.height) != (w, h) {

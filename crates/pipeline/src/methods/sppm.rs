@@ -60,10 +60,7 @@ fn diffuse_area(scene: &Scene) -> f64 {
     let mesh = scene.geometry.mesh();
     let tris: f64 = (0..mesh.len())
         .filter(|&t| scene.is_diffuse(mesh.materials[t]))
-        .map(|t| {
-            let [a, b, c] = mesh.vertices(t);
-            0.5 * (b - a).cross(c - a).length() as f64
-        })
+        .map(|t| mesh.area(t) as f64)
         .sum();
     let spheres: f64 = scene
         .geometry
@@ -139,13 +136,6 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     let mut passes = 0u32;
     let mut snapshots = Vec::new();
     let mut photons_stored = 0u64;
-    let pool = run
-        .threads
-        .and_then(|n| rayon::ThreadPoolBuilder::new().num_threads(n).build().ok());
-    let in_pool = |f: &mut (dyn FnMut() + Send)| match &pool {
-        Some(p) => p.install(f),
-        None => f(),
-    };
     while passes < sp.passes {
         let pass = passes as u64;
         let points = eye::visible_points(scene, pass, sp.direct, run.threads);
@@ -153,7 +143,7 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
         photons_stored += photons.len() as u64;
         let map = PhotonMap::build(photons, IndexKind::KdTree);
         // Each pixel's update reads only its own statistics: the same for any thread count.
-        in_pool(&mut || {
+        eye::on_threads(run.threads, || {
             stats
                 .par_iter_mut()
                 .zip(&points)
