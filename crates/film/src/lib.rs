@@ -18,6 +18,7 @@
 mod bias;
 mod error;
 mod film;
+mod flip;
 mod img;
 mod io;
 mod metrics;
@@ -25,6 +26,7 @@ mod metrics;
 pub use bias::{BiasVariance, RegionSums};
 pub use error::FilmError;
 pub use film::{Film, Layer, Normalize, Rect, TileBuffer, tiles};
+pub use flip::{FlipMap, flip};
 pub use img::{Image, composite};
 pub use io::{ToneMap, read_exr, write_atomic, write_exr, write_png};
 pub use metrics::{Mask, Metrics, RELMSE_EPSILON, metrics};

@@ -583,3 +583,47 @@ fn bias_and_variance_are_recovered_from_injected_ones() {
         Err(FilmError::TooFewRuns { runs: 1 })
     ));
 }
+
+#[test]
+fn flip_is_zero_for_equal_images_and_grows_with_the_difference() {
+    // A smooth gradient, and the same with a bright square over its left half's centre.
+    let (w, h) = (64, 32);
+    let base = Image::from_fn(w, h, |x, _| [x as f32 / w as f32 * 0.8; 3]);
+    let with_square = |v: f32| {
+        let mut img = base.clone();
+        for y in 12..20 {
+            for x in 12..20 {
+                img.set(x, y, [v; 3]);
+            }
+        }
+        img
+    };
+    let same = flip(&base, &base, 1.0).unwrap();
+    assert_eq!(same.mean(None).unwrap(), Some(0.0));
+    let small = flip(&with_square(0.3), &base, 1.0).unwrap();
+    let large = flip(&with_square(1.0), &base, 1.0).unwrap();
+    let square = Mask::rect(w, h, 12, 12, 20, 20);
+    let (s, l) = (
+        small.mean(Some(&square)).unwrap().unwrap(),
+        large.mean(Some(&square)).unwrap().unwrap(),
+    );
+    assert!(s > 0.05 && l > s + 0.1, "FLIP in the square: {s} then {l}");
+    // FLIP's filters reach a few pixels at 67 pixels per degree, not across the image.
+    let far = Mask::rect(w, h, 40, 0, 64, 32);
+    assert!(large.mean(Some(&far)).unwrap().unwrap() < 1e-3);
+    // Exposure tone-maps both images alike: scaling both leaves equal images equal.
+    assert_eq!(
+        flip(&base, &base, 4.0).unwrap().mean(None).unwrap(),
+        Some(0.0)
+    );
+}
+
+#[test]
+fn flip_reports_size_problems_as_errors() {
+    let err = flip(&Image::new(4, 4), &Image::new(4, 5), 1.0).unwrap_err();
+    assert!(matches!(err, FilmError::SizeMismatch { .. }), "{err}");
+    let map = flip(&Image::new(4, 4), &Image::new(4, 4), 1.0).unwrap();
+    assert!(map.mean(Some(&Mask::all(5, 4))).is_err());
+    assert_eq!(map.mean(Some(&Mask::rect(4, 4, 0, 0, 0, 0))).unwrap(), None);
+    assert!(flip(&Image::new(0, 0), &Image::new(0, 0), 1.0).is_err());
+}

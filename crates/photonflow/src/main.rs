@@ -430,7 +430,8 @@ fn run(cmd: Cmd) -> Result<(), String> {
         } => composite::run(&inputs, &out, exposure),
         Cmd::Compare { a, b, mask } => {
             let m = pipeline::output::compare(&a, &b, mask)?;
-            println!("{m}");
+            let flip = pipeline::output::compare_flip(&a, &b, mask)?;
+            println!("{m} flip={flip:.5}");
             Ok(())
         }
         Cmd::BenchPhotons {

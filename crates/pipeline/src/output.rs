@@ -207,6 +207,18 @@ fn remove_if_present(p: &Path) -> Result<(), String> {
     }
 }
 
+/// Mean LDR-FLIP of image `a` against reference `b` (linear EXR files; exposure 1, gamma
+/// 2.2, `film::flip`), inside `mask`.
+pub fn compare_flip(a: &Path, b: &Path, mask: Option<[usize; 4]>) -> Result<f64, String> {
+    let ia = film::read_exr(a).map_err(|e| e.to_string())?;
+    let ib = film::read_exr(b).map_err(|e| e.to_string())?;
+    let mask = mask.map(|[x0, y0, x1, y1]| Mask::rect(ia.width, ia.height, x0, y0, x1, y1));
+    let map = film::flip(&ia, &ib, 1.0).map_err(|e| e.to_string())?;
+    map.mean(mask.as_ref())
+        .map_err(|e| e.to_string())?
+        .ok_or_else(|| format!("{}: the mask selects no pixel", a.display()))
+}
+
 /// Error metrics of image `a` against reference `b` (linear EXR files), inside `mask`.
 pub fn compare(a: &Path, b: &Path, mask: Option<[usize; 4]>) -> Result<film::Metrics, String> {
     let ia = film::read_exr(a).map_err(|e| e.to_string())?;
