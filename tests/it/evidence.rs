@@ -5,7 +5,7 @@ use film::Image;
 use pipeline::Overrides;
 use pipeline::evidence::{Budget, Technique, regions, render_image, rung};
 use scene::{Method, Scene};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use tests::{TempDir, scenes_dir};
 
 const RES: u32 = 48;
@@ -40,10 +40,8 @@ fn bias_is_zero_for_the_path_tracer_and_grows_with_k_at_the_caustic() {
     let scene = worksheet(1).unwrap();
     let regions = regions(&scene);
     let region = |r: &pipeline::evidence::RungResult, name: &str| {
-        r.regions
-            .iter()
-            .find(|(n, _, _)| *n == name)
-            .map(|(_, e, s)| (*e, *s))
+        r.region(name)
+            .map(|x| (x.errors, x.sums))
             .unwrap_or_else(|| panic!("no region {name}"))
     };
     let seeds = 8;
@@ -57,6 +55,7 @@ fn bias_is_zero_for_the_path_tracer_and_grows_with_k_at_the_caustic() {
         },
         budget: Budget::Spp,
         ladder: vec![64],
+        layer: None,
     };
     let r = rung(
         &worksheet, &path, 64, seeds, &reference, &regions, &cache, None,
@@ -79,6 +78,7 @@ fn bias_is_zero_for_the_path_tracer_and_grows_with_k_at_the_caustic() {
         },
         budget: Budget::Photons,
         ladder: vec![200_000],
+        layer: None,
     };
     let bias = |k| {
         let r = rung(
@@ -104,4 +104,182 @@ fn bias_is_zero_for_the_path_tracer_and_grows_with_k_at_the_caustic() {
         large.bias2 > 2.0 * small.bias2,
         "k = 50: {small:?}, k = 1000: {large:?}"
     );
+}
+
+/// The relative links of a report: `src="..."` and `href="..."` in HTML, `](...)` in Markdown.
+fn links(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    for open in ["src=\"", "href=\"", "]("] {
+        let close = if open == "](" { ')' } else { '"' };
+        for (i, _) in text.match_indices(open) {
+            let rest = &text[i + open.len()..];
+            if let Some(end) = rest.find(close) {
+                out.push(rest[..end].to_string());
+            }
+        }
+    }
+    out
+}
+
+/// Files `links` names that are missing or do not decode (PNG) or are not SVG documents.
+fn broken(dir: &Path, links: &[String]) -> Vec<String> {
+    links
+        .iter()
+        .filter(|l| {
+            let p = dir.join(l);
+            let ok = if l.ends_with(".png") {
+                image::open(&p).is_ok_and(|i| i.width() > 0)
+            } else if l.ends_with(".svg") {
+                std::fs::read_to_string(&p)
+                    .is_ok_and(|s| s.contains("<svg") && s.contains("</svg>"))
+            } else {
+                p.is_file()
+            };
+            // Offline and self-contained: no absolute path, no scheme, no parent directory.
+            !ok || l.contains("://") || l.starts_with('/') || l.contains("..")
+        })
+        .cloned()
+        .collect()
+}
+
+/// Chromium, if installed (`apt-get install chromium` on Debian; or set `CHROMIUM`).
+fn chromium() -> Option<PathBuf> {
+    std::env::var_os("CHROMIUM").map(PathBuf::from).or_else(|| {
+        ["/usr/bin/chromium", "/usr/bin/chromium-browser"]
+            .iter()
+            .map(PathBuf::from)
+            .find(|p| p.is_file())
+    })
+}
+
+/// Runs headless Chromium with `args` (the flags a sandboxed, offline machine needs), killed
+/// after a minute; its standard output.
+fn run_chromium(exe: &Path, profile: &Path, args: &[String]) -> String {
+    let mut child = std::process::Command::new(exe)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--allow-file-access-from-files",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap_or_else(|e| panic!("{}: {e}", exe.display()));
+    let t0 = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if t0.elapsed().as_secs() > 60 {
+            let _ = child.kill();
+            panic!("chromium did not finish in 60 s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    let mut out = String::new();
+    std::io::Read::read_to_string(&mut child.stdout.take().unwrap(), &mut out).unwrap();
+    out
+}
+
+#[test]
+fn the_report_links_resolve_and_a_browser_shows_its_images() {
+    let dir = TempDir::new("evidence-report");
+    // The worksheet scene at 64 x 64, its meshes named by absolute paths.
+    let src = scenes_dir().join("cornell-spheres");
+    let text = std::fs::read_to_string(src.join("analytic.toml"))
+        .unwrap()
+        .replace("obj = \"", &format!("obj = \"{}/", src.display()))
+        .replace("width = 512", "width = 64")
+        .replace("height = 512", "height = 64");
+    let scene = dir.path().join("small.toml");
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.path().join("evidence");
+    pipeline::evidence::run(&pipeline::evidence::EvidenceArgs {
+        scene,
+        reference: None,
+        reference_spp: 64,
+        seeds: 2,
+        quick: true,
+        budget_scale: 0.02,
+        out: out.clone(),
+        threads: None,
+    })
+    .unwrap_or_else(|e| panic!("{e}"));
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let (hl, ml) = (links(&html), links(&md));
+    // The reference, and per technique its image, crops and two maps; the plots.
+    assert!(
+        hl.len() > 60 && ml.len() > 30,
+        "{} and {} links",
+        hl.len(),
+        ml.len()
+    );
+    for plot in ["error-vs-time", "regions", "k-caustic", "caustic-vs-time"] {
+        assert!(
+            hl.iter().any(|l| l == &format!("plots/{plot}.svg")),
+            "no {plot}"
+        );
+    }
+    assert_eq!(broken(&out, &hl), Vec::<String>::new());
+    assert_eq!(broken(&out, &ml), Vec::<String>::new());
+    // The check sees a missing image.
+    std::fs::rename(out.join("images/reference.png"), out.join("moved.png")).unwrap();
+    assert_eq!(
+        broken(&out, &hl),
+        vec!["images/reference.png".to_string(); 2]
+    );
+    std::fs::rename(out.join("moved.png"), out.join("images/reference.png")).unwrap();
+
+    let Some(exe) = chromium() else {
+        eprintln!("Chromium not installed (apt-get install chromium): browser check skipped");
+        return;
+    };
+    // Every <img> loaded in a real browser: a copy of the page that writes the count of
+    // decoded images into its title once the page has loaded.
+    let probe = html.replace(
+        "</body>",
+        "<script>addEventListener('load', () => { const i = [...document.images]; \
+         document.title = 'loaded ' + i.filter(x => x.complete && x.naturalWidth > 0).length \
+         + ' of ' + i.length; });</script></body>",
+    );
+    std::fs::write(out.join("probe.html"), probe).unwrap();
+    let profile = dir.path().join("chromium");
+    let dom = run_chromium(
+        &exe,
+        &profile,
+        &[
+            "--virtual-time-budget=10000".into(),
+            "--dump-dom".into(),
+            format!("file://{}", out.join("probe.html").display()),
+        ],
+    );
+    let images = html.matches("<img ").count();
+    assert!(
+        dom.contains(&format!("<title>loaded {images} of {images}</title>")),
+        "{images} images; the page says {:?}",
+        dom.lines().find(|l| l.contains("<title>"))
+    );
+    // And a screenshot shows them: far from a white page.
+    let shot = dir.path().join("shot.png");
+    run_chromium(
+        &exe,
+        &profile,
+        &[
+            "--window-size=1280,2000".into(),
+            format!("--screenshot={}", shot.display()),
+            format!("file://{}", out.join("report.html").display()),
+        ],
+    );
+    let img = image::open(&shot).unwrap().to_rgb8();
+    let dark = img
+        .pixels()
+        .filter(|p| p.0.iter().all(|&c| c < 200))
+        .count();
+    let share = dark as f64 / (img.width() * img.height()) as f64;
+    assert!(share > 0.05, "{share} of the screenshot is dark");
 }

@@ -23,11 +23,12 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
                       worksheet 7's images (box kernel, Silverman, + topological test,
                       + boundary correction) with errors against a path-traced reference,
                       summarised in out/worksheet/README.md
-  evidence [SCENE] [--quick] [--seeds K] [--reference EXR] [--reference-spp N]
+  evidence [SCENE] [--quick] [--seeds K] [--budget-scale F] [--reference EXR] [--reference-spp N]
                       each technique over a ladder of budgets, K seeds each, against a
-                      reference: relMSE (two conventions), RMSE, mean ratio, bias^2 and variance
-                      per region (caustic, edges and corners, glass sphere, open walls);
-                      out/evidence/evidence.md, evidence.json, maps/ (EXR and false colour)
+                      reference: relMSE (two conventions), RMSE, mean ratio, FLIP, bias^2 and
+                      variance per region (caustic, edges and corners, outer rim, glass sphere,
+                      open walls), the k sweep; the lab report out/evidence/report.html and
+                      report.md with images, crops, maps and SVG plots; evidence.md, evidence.json
   composite RUN... --out DIR
                       combine runs of one view: layers of one name averaged by their counts,
                       disjoint layers summed (independent runs: other --seed)

@@ -155,6 +155,9 @@ enum Cmd {
         /// The short ladder: a few minutes on 2 cores.
         #[arg(long)]
         quick: bool,
+        /// Multiply every budget of the ladder and the k sweep's photon counts by this.
+        #[arg(long, default_value_t = 1.0)]
+        budget_scale: f64,
         #[arg(long, default_value = "out/evidence")]
         out: PathBuf,
         #[arg(long)]
@@ -298,6 +301,7 @@ impl PhotonArgs {
             caustics: None,
             passes: self.passes,
             splat_photons: None,
+            splat_indirect: None,
             time: self.time,
         }
     }
@@ -465,6 +469,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
             reference_spp,
             seeds,
             quick,
+            budget_scale,
             out,
             threads,
         } => pipeline::evidence::run(&pipeline::evidence::EvidenceArgs {
@@ -473,6 +478,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
             reference_spp,
             seeds,
             quick,
+            budget_scale,
             out,
             threads,
         }),

@@ -11,7 +11,6 @@ use crate::{Overrides, Settings, worksheet};
 use density::Kernel;
 use film::{BiasVariance, Image, Mask};
 use scene::{Material, Method, Scene};
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -24,6 +23,8 @@ pub struct EvidenceArgs {
     pub seeds: u32,
     /// The short ladder (minutes on 2 cores).
     pub quick: bool,
+    /// Every budget (and the k sweep's photon count) times this, at least 1.
+    pub budget_scale: f64,
     pub out: PathBuf,
     pub threads: Option<usize>,
 }
@@ -35,6 +36,9 @@ pub struct Technique {
     /// What each rung sets: `spp`, `photons` or `passes`.
     pub budget: Budget,
     pub ladder: Vec<u64>,
+    /// Compare this layer alone (with the reference's layer of that name) instead of the
+    /// whole image: the caustic map against splatting.
+    pub layer: Option<&'static str>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -42,23 +46,27 @@ pub enum Budget {
     Spp,
     Photons,
     Passes,
+    /// Caustic paths per splatting pass.
+    SplatPhotons,
 }
 
 impl Budget {
-    fn name(self) -> &'static str {
+    pub fn name(self) -> &'static str {
         match self {
             Budget::Spp => "spp",
             Budget::Photons => "photon paths",
             Budget::Passes => "passes",
+            Budget::SplatPhotons => "caustic paths",
         }
     }
 
-    fn apply(self, o: &Overrides, n: u64) -> Overrides {
+    pub fn apply(self, o: &Overrides, n: u64) -> Overrides {
         let mut o = o.clone();
         match self {
             Budget::Spp => o.spp = Some(n as u32),
             Budget::Photons => o.photons = Some(n),
             Budget::Passes => o.passes = Some(n as u32),
+            Budget::SplatPhotons => o.splat_photons = Some(n),
         }
         o
     }
@@ -66,7 +74,8 @@ impl Budget {
 
 /// The techniques the issue names: the path tracer, path + splatted caustics, the global
 /// map shown directly (box and Silverman kernels, + the topological test, + boundary
-/// correction), final gathering and SPPM.
+/// correction), final gathering, SPPM, and the caustic map against splatting (the `caustic`
+/// layer alone: `L S+ D E`, caustics seen directly).
 pub fn techniques(quick: bool) -> Vec<Technique> {
     let ladder = |q: &[u64], full: &[u64]| if quick { q.to_vec() } else { full.to_vec() };
     let gd = |kernel: Kernel, topo: Option<f32>, boundary: bool| Overrides {
@@ -85,62 +94,101 @@ pub fn techniques(quick: bool) -> Vec<Technique> {
             name: "path",
             overrides: m(Method::Path),
             budget: Budget::Spp,
+            layer: None,
             ladder: ladder(&[4, 16], &[16, 64, 256]),
         },
         Technique {
             name: "path+splat",
             overrides: m(Method::PathSplat),
             budget: Budget::Spp,
+            layer: None,
             ladder: ladder(&[4, 16], &[4, 16, 64]),
         },
         Technique {
             name: "global map, box",
             overrides: gd(Kernel::Uniform, None, false),
             budget: Budget::Photons,
+            layer: None,
             ladder: ladder(&[50_000, 200_000], &[100_000, 400_000, 1_600_000]),
         },
         Technique {
             name: "global map, Silverman",
             overrides: gd(Kernel::Silverman, None, false),
             budget: Budget::Photons,
+            layer: None,
             ladder: ladder(&[50_000, 200_000], &[100_000, 400_000, 1_600_000]),
         },
         Technique {
             name: "global map, Silverman + topological test",
             overrides: gd(Kernel::Silverman, Some(0.1), false),
             budget: Budget::Photons,
+            layer: None,
             ladder: ladder(&[50_000, 200_000], &[100_000, 400_000, 1_600_000]),
         },
         Technique {
             name: "global map, Silverman + topological test + boundary correction",
             overrides: gd(Kernel::Silverman, Some(0.1), true),
             budget: Budget::Photons,
+            layer: None,
             ladder: ladder(&[50_000, 200_000], &[100_000, 400_000, 1_600_000]),
         },
         Technique {
             name: "final gathering",
             overrides: m(Method::FinalGather),
             budget: Budget::Spp,
+            layer: None,
             ladder: ladder(&[1], &[1, 4]),
         },
         Technique {
             name: "sppm",
             overrides: m(Method::Sppm),
             budget: Budget::Passes,
+            layer: None,
             ladder: ladder(&[4, 16], &[4, 16, 64]),
+        },
+        // The caustic map as the course's final gathering makes it (k = 250, every path of
+        // the trace paid for, the global set's included, and direct light), against
+        // photon-differential splatting onto eye vertices (no map, no global set).
+        Technique {
+            name: "caustic map (k-NN)",
+            overrides: Overrides {
+                method: Some(Method::FinalGather),
+                gather_rays: Some(0),
+                ..Overrides::default()
+            },
+            budget: Budget::Photons,
+            layer: Some("caustic"),
+            ladder: ladder(&[200_000, 1_000_000], &[200_000, 1_000_000, 4_000_000]),
+        },
+        Technique {
+            name: "caustic splat (differentials)",
+            overrides: Overrides {
+                method: Some(Method::CausticSplat),
+                splat_indirect: Some(false),
+                ..Overrides::default()
+            },
+            budget: Budget::SplatPhotons,
+            layer: Some("caustic"),
+            ladder: ladder(&[250_000, 1_000_000], &[250_000, 1_000_000, 4_000_000]),
         },
     ]
 }
 
 /// The named regions of an image of `scene`, from its geometry: the caustic under the glass
-/// sphere, the inner edges and corners of the box, the glass sphere, the open walls (diffuse
-/// surfaces away from edges and caustics), and the whole image.
+/// sphere, the inner edges and corners of the box, its outer rim (the open front), the glass
+/// sphere, the open walls (diffuse surfaces away from edges and caustics), and the whole
+/// image.
 pub fn regions(scene: &Scene) -> Vec<(&'static str, Mask)> {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let caustic = worksheet::caustic_region(scene, 1.6);
     // Edge band: two percent of the scene's diagonal (the k-NN discs' scale).
     let b = scene.geometry.bounds();
-    let edges = worksheet::edge_mask(scene, 0.02 * (b.max - b.min).length());
+    let band = 0.02 * (b.max - b.min).length();
+    let rim = worksheet::rim_mask(scene, band);
+    let inner = worksheet::edge_mask(scene, band);
+    let edges = Mask::from_fn(w, h, |x, y| {
+        inner.pixels[y * w + x] && !rim.pixels[y * w + x]
+    });
     let seen = |x: usize, y: usize| {
         scene
             .geometry
@@ -157,38 +205,55 @@ pub fn regions(scene: &Scene) -> Vec<(&'static str, Mask)> {
     let walls = Mask::from_fn(w, h, |x, y| {
         let i = y * w + x;
         !caustic.pixels[i]
-            && !edges.pixels[i]
+            && !inner.pixels[i]
+            && !rim.pixels[i]
             && seen(x, y).is_some_and(|hit| scene.is_diffuse(hit.material))
     });
     vec![
         ("image", Mask::all(w, h)),
         ("caustic", caustic),
         ("edges and corners", edges),
+        ("outer rim", rim),
         ("glass sphere", glass),
         ("open walls", walls),
     ]
 }
 
 /// Mean errors of a rung's runs over one region: relative MSE as `(v - r)² / (r² + 0.01)`
-/// and as pbrt's `(v - r)² / (r + 0.01)²`, RMSE, and the ratio of the means
-/// (`film::metrics` of each run, averaged).
+/// and as pbrt's `(v - r)² / (r + 0.01)²`, RMSE, the ratio of the means (`film::metrics` of
+/// each run) and LDR-FLIP (`film::flip`), each averaged over the runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Errors {
     pub relmse: f64,
     pub relmse_pbrt: f64,
     pub rmse: f64,
     pub mean_ratio: f64,
+    pub flip: f64,
 }
 
-/// One rung's result: its mean time and, per region, the mean errors over the runs and the
-/// relative bias² and variance.
+/// One region of a rung: its mean errors over the runs and its relative bias² and variance.
+#[derive(Clone, Debug)]
+pub struct RegionResult {
+    pub region: &'static str,
+    pub errors: Errors,
+    pub sums: film::RegionSums,
+}
+
+/// One rung's result: its mean time, its regions, the maps and the first run's image.
 pub struct RungResult {
     pub technique: &'static str,
     pub budget: Budget,
     pub amount: u64,
     pub seconds: f64,
-    pub regions: Vec<(&'static str, Errors, film::RegionSums)>,
+    pub regions: Vec<RegionResult>,
     pub maps: BiasVariance,
+    pub first: Image,
+}
+
+impl RungResult {
+    pub fn region(&self, name: &str) -> Option<&RegionResult> {
+        self.regions.iter().find(|r| r.region == name)
+    }
 }
 
 /// The image a method renders of `scene` with `o` (photons traced into `cache`).
@@ -213,7 +278,8 @@ pub fn render_image(
 }
 
 /// Renders one rung with seeds `1..=seeds` (`scene(seed)` makes the scene of each) and
-/// decomposes its error.
+/// decomposes its error against `reference` (the reference's layer `t.layer`, for a
+/// technique that compares one layer).
 #[allow(clippy::too_many_arguments)]
 pub fn rung(
     scene: &dyn Fn(u64) -> Result<Scene, String>,
@@ -233,13 +299,27 @@ pub fn rung(
         // Each run traces its own photons: the seed changes them, and the time counts them.
         let _ = std::fs::remove_dir_all(cache);
         let t0 = Instant::now();
-        let (img, _) = render_image(&scene, &o, cache, threads)?;
+        let (img, r) = render_image(&scene, &o, cache, threads)?;
         seconds += t0.elapsed().as_secs_f64();
+        let img = match t.layer {
+            None => img,
+            Some(name) => {
+                r.layers
+                    .into_iter()
+                    .find(|l| l.name == name)
+                    .ok_or_else(|| format!("{}: the run made no `{name}` layer", t.name))?
+                    .image
+            }
+        };
         images.push(img);
     }
     let _ = std::fs::remove_dir_all(cache);
     let runs: Vec<&Image> = images.iter().collect();
     let maps = BiasVariance::new(&runs, reference, true).map_err(|e| e.to_string())?;
+    let flips = images
+        .iter()
+        .map(|img| film::flip(img, reference, 1.0).map_err(|e| e.to_string()))
+        .collect::<Result<Vec<_>, _>>()?;
     let mut out = Vec::new();
     let k = images.len() as f64;
     for (name, mask) in regions {
@@ -248,15 +328,24 @@ pub fn rung(
             continue;
         }
         let mut e = Errors::default();
-        for img in &images {
+        for (img, flip) in images.iter().zip(&flips) {
             let m = film::metrics(img, reference, Some(mask)).map_err(|e| e.to_string())?;
             e.relmse += m.relmse / k;
             e.relmse_pbrt += m.relmse_pbrt / k;
             e.rmse += m.rmse / k;
             e.mean_ratio += m.mean_a / m.mean_b / k;
+            e.flip += flip
+                .mean(Some(mask))
+                .map_err(|e| e.to_string())?
+                .unwrap_or(0.0)
+                / k;
         }
         let sums = maps.region(Some(mask)).map_err(|e| e.to_string())?;
-        out.push((*name, e, sums));
+        out.push(RegionResult {
+            region: name,
+            errors: e,
+            sums,
+        });
     }
     Ok(RungResult {
         technique: t.name,
@@ -265,24 +354,69 @@ pub fn rung(
         seconds: seconds / seeds as f64,
         regions: out,
         maps,
+        first: images.swap_remove(0),
     })
 }
 
 /// The reference (`accuracy::reference`: given, or path-traced once and cached in `out`),
-/// read and checked against the scene's size.
-fn reference(scene: &Scene, a: &EvidenceArgs) -> Result<Image, String> {
+/// read and checked against the scene's size, with its caustic layer when it has one (a
+/// path-traced reference does: `layers/caustic.exr` beside the image).
+pub struct Reference {
+    pub path: PathBuf,
+    pub image: Image,
+    pub caustic: Option<Image>,
+}
+
+fn reference(scene: &Scene, a: &EvidenceArgs) -> Result<Reference, String> {
     let path = crate::accuracy::reference(scene, a.reference.as_deref(), a.reference_spp, &a.out)?;
-    let img = film::read_exr(&path).map_err(|e| e.to_string())?;
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-    if (img.width, img.height) != (w, h) {
-        return Err(format!(
-            "{}: reference is {}x{}, the scene renders {w}x{h}",
-            path.display(),
-            img.width,
-            img.height
-        ));
-    }
-    Ok(img)
+    let read = |p: &Path| -> Result<Image, String> {
+        let img = film::read_exr(p).map_err(|e| e.to_string())?;
+        if (img.width, img.height) != (w, h) {
+            return Err(format!(
+                "{}: reference is {}x{}, the scene renders {w}x{h}",
+                p.display(),
+                img.width,
+                img.height
+            ));
+        }
+        Ok(img)
+    };
+    let image = read(&path)?;
+    let layer = path.with_file_name("layers").join("caustic.exr");
+    let caustic = if layer.is_file() {
+        Some(read(&layer)?)
+    } else {
+        None
+    };
+    Ok(Reference {
+        path,
+        image,
+        caustic,
+    })
+}
+
+/// Everything an evidence run measured: the report and the plots are made from it.
+pub struct Evidence {
+    pub scene: PathBuf,
+    pub seeds: u32,
+    pub reference: String,
+    pub reference_image: Image,
+    pub rungs: Vec<RungResult>,
+    /// The k sweep at a fixed photon count, then photons grown with k.
+    pub sweep: Vec<SweepResult>,
+    pub sweep_photons: u64,
+    /// Why a technique was left out (no reference layer to compare with, say).
+    pub skipped: Vec<String>,
+}
+
+/// One point of the k sweep.
+pub struct SweepResult {
+    /// The kernel and tests (`box`, `Silverman`, ...), or the grown-together series.
+    pub variant: String,
+    pub k: usize,
+    pub photons: u64,
+    pub rung: RungResult,
 }
 
 pub fn run(a: &EvidenceArgs) -> Result<(), String> {
@@ -292,102 +426,74 @@ pub fn run(a: &EvidenceArgs) -> Result<(), String> {
             a.seeds
         ));
     }
+    if !(a.budget_scale > 0.0 && a.budget_scale <= 1e3) {
+        return Err(format!(
+            "--budget-scale {} must be in (0, 1000]",
+            a.budget_scale
+        ));
+    }
+    let scale = |n: u64| ((n as f64 * a.budget_scale).round() as u64).max(1);
     let scene = Scene::load(&a.scene).map_err(|e| e.to_string())?;
     std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
     let reference = reference(&scene, a)?;
     let regions = regions(&scene);
+    let caustic_regions: Vec<(&'static str, Mask)> = regions
+        .iter()
+        .filter(|(n, _)| matches!(*n, "image" | "caustic"))
+        .cloned()
+        .collect();
     let cache = a.out.join("cache");
-    let mut md = String::new();
-    let _ = writeln!(
-        md,
-        "# Evidence: {}\n\n{} independent runs per rung (seeds 1..={}); errors against {}; \
-         relative MSE `(v - r)^2 / (r^2 + 0.01)` (relMSE) and pbrt's `(v - r)^2 / (r + 0.01)^2` \
-         (relMSE pbrt), means over the runs; bias^2 and variance relative \
-         (`/ (r^2 + 0.01)`), from the runs: bias^2 + variance = one run's relMSE.\n",
-        a.scene.display(),
-        a.seeds,
-        a.seeds,
-        a.reference.as_ref().map_or(
-            format!("a {}-spp path-traced reference", a.reference_spp),
-            |p| p.display().to_string()
-        )
-    );
-    let _ = writeln!(
-        md,
-        "| technique | budget | time (s) | region | relMSE | relMSE pbrt | RMSE | mean / ref | bias^2 | variance |\n|---|---|---|---|---|---|---|---|---|---|"
-    );
-    let mut json = Vec::new();
     let make = |seed: u64| Scene::load_with(&a.scene, |f| f.seed = seed).map_err(|e| e.to_string());
-    for t in techniques(a.quick) {
+    let mut ev = Evidence {
+        scene: a.scene.clone(),
+        seeds: a.seeds,
+        reference: a.reference.as_ref().map_or(
+            format!("a {}-spp path-traced reference", a.reference_spp),
+            |p| p.display().to_string(),
+        ),
+        reference_image: reference.image.clone(),
+        rungs: Vec::new(),
+        sweep: Vec::new(),
+        sweep_photons: scale(200_000),
+        skipped: Vec::new(),
+    };
+    for mut t in techniques(a.quick) {
+        t.ladder = t.ladder.iter().map(|&n| scale(n)).collect();
+        t.ladder.dedup();
+        let (reference, regions) = match t.layer {
+            None => (&reference.image, &regions),
+            Some(_) => match &reference.caustic {
+                Some(c) => (c, &caustic_regions),
+                None => {
+                    ev.skipped.push(format!(
+                        "{}: the reference {} has no layers/caustic.exr beside it",
+                        t.name,
+                        reference.path.display()
+                    ));
+                    continue;
+                }
+            },
+        };
         for &amount in &t.ladder {
             let r = rung(
-                &make, &t, amount, a.seeds, &reference, &regions, &cache, a.threads,
+                &make, &t, amount, a.seeds, reference, regions, &cache, a.threads,
             )?;
-            let label = format!("{} {}", r.amount, r.budget.name());
             println!(
-                "{:<64} {label:>22} {:8.2} s  relMSE {:.5}",
-                r.technique, r.seconds, r.regions[0].1.relmse
+                "{:<64} {:>22} {:8.2} s  relMSE {:.5}  FLIP {:.4}",
+                r.technique,
+                format!("{} {}", r.amount, r.budget.name()),
+                r.seconds,
+                r.regions[0].errors.relmse,
+                r.regions[0].errors.flip,
             );
-            for (region, e, s) in &r.regions {
-                let _ = writeln!(
-                    md,
-                    "| {} | {label} | {:.2} | {region} | {:.5} | {:.5} | {:.5} | {:.4} | {:.5} | {:.5} |",
-                    r.technique,
-                    r.seconds,
-                    e.relmse,
-                    e.relmse_pbrt,
-                    e.rmse,
-                    e.mean_ratio,
-                    s.bias2,
-                    s.variance
-                );
-                json.push(serde_json::json!({
-                    "technique": r.technique, "budget": r.budget.name(), "amount": r.amount,
-                    "seconds": r.seconds, "region": region, "pixels": s.pixels,
-                    "relmse": e.relmse, "relmse_pbrt": e.relmse_pbrt, "rmse": e.rmse,
-                    "mean_ratio": e.mean_ratio, "bias2": s.bias2, "variance": s.variance,
-                    "mse": s.mse,
-                }));
-            }
-            // Maps of each rung: EXR (linear) and false colour (square-root scale up to the
-            // rung's 99th percentile of bias^2 + variance).
-            let dir = a
-                .out
-                .join("maps")
-                .join(slug(&format!("{}-{}", r.technique, r.amount)));
-            std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-            let mut both: Vec<f64> = r
-                .maps
-                .bias2
-                .iter()
-                .zip(&r.maps.variance)
-                .map(|(b, v)| b + v)
-                .collect();
-            both.sort_by(f64::total_cmp);
-            let top = both[(both.len() * 99 / 100).min(both.len() - 1)];
-            for (name, map) in [("bias2", &r.maps.bias2), ("variance", &r.maps.variance)] {
-                film::write_exr(dir.join(format!("{name}.exr")), &r.maps.image(map))
-                    .map_err(|e| e.to_string())?;
-                film::write_png(
-                    dir.join(format!("{name}.png")),
-                    &r.maps.false_colour(map, top),
-                    &film::ToneMap {
-                        gamma: 1.0,
-                        exposure: 0.0,
-                    },
-                )
-                .map_err(|e| e.to_string())?;
-            }
-            film::write_exr(dir.join("mean.exr"), &r.maps.mean).map_err(|e| e.to_string())?;
+            ev.rungs.push(r);
         }
     }
-    k_sweep(a, &make, &reference, &regions, &cache, &mut md, &mut json)?;
-    film::write_atomic(&a.out.join("evidence.md"), md.as_bytes()).map_err(|e| e.to_string())?;
-    let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
-    film::write_atomic(&a.out.join("evidence.json"), text.as_bytes()).map_err(|e| e.to_string())?;
+    k_sweep(a, &make, &reference.image, &regions, &cache, &mut ev)?;
+    crate::report::write(&a.out, &ev, &scene, &regions)?;
     println!(
-        "wrote {} (table), evidence.json and maps/",
-        a.out.join("evidence.md").display()
+        "wrote {} and report.html, evidence.md (tables), evidence.json, maps/, plots/",
+        a.out.join("report.md").display()
     );
     Ok(())
 }
@@ -395,70 +501,45 @@ pub fn run(a: &EvidenceArgs) -> Result<(), String> {
 /// The worksheet's trade-off itself: the global map shown directly, k swept for each kernel,
 /// with and without the topological test and boundary correction, at a fixed photon count
 /// (bias^2 rises and variance falls with k); then photons and k grown together (`photons /
-/// k` fixed, so the disc keeps its size: the bias stays, the noise falls; each rung's time is
-/// in evidence.json).
+/// k` fixed, so the disc keeps its size: the bias stays, the noise falls).
 fn k_sweep(
     a: &EvidenceArgs,
     make: &dyn Fn(u64) -> Result<Scene, String>,
     reference: &Image,
     regions: &[(&'static str, Mask)],
     cache: &Path,
-    md: &mut String,
-    json: &mut Vec<serde_json::Value>,
+    ev: &mut Evidence,
 ) -> Result<(), String> {
     let ks: &[usize] = if a.quick {
         &[50, 250, 1000]
     } else {
         &[50, 100, 250, 500, 1000, 2000]
     };
-    let photons = 200_000u64;
-    let variants: [(&str, Kernel, Option<f32>, bool); 4] = [
-        ("box", Kernel::Uniform, None, false),
-        ("Silverman", Kernel::Silverman, None, false),
-        (
-            "Silverman + topological test",
-            Kernel::Silverman,
-            Some(0.1),
-            false,
-        ),
-        (
-            "Silverman + topological test + boundary",
-            Kernel::Silverman,
-            Some(0.1),
-            true,
-        ),
-    ];
-    let _ = writeln!(
-        md,
-        "\n## The global map's k against bias and variance ({photons} photon paths)\n\n\
-         | kernel | k | region | bias^2 | variance | relMSE |\n|---|---|---|---|---|---|"
-    );
-    let mut sweep = |md: &mut String, label: String, o: Overrides, amount: u64| {
+    let photons = ev.sweep_photons;
+    let mut sweep = |variant: &str, o: Overrides, k: usize, amount: u64| {
         let t = Technique {
             name: "global map",
             overrides: o,
             budget: Budget::Photons,
             ladder: vec![amount],
+            layer: None,
         };
         let r = rung(
             make, &t, amount, a.seeds, reference, regions, cache, a.threads,
         )?;
-        println!("k sweep {label:<58} relMSE {:.5}", r.regions[0].1.relmse);
-        for (region, e, s) in &r.regions {
-            let _ = writeln!(
-                md,
-                "| {label} | {region} | {:.5} | {:.5} | {:.5} |",
-                s.bias2, s.variance, e.relmse
-            );
-            json.push(serde_json::json!({
-                "sweep": label, "photons": amount, "region": region, "seconds": r.seconds,
-                "mean_ratio": e.mean_ratio,
-                "bias2": s.bias2, "variance": s.variance, "relmse": e.relmse,
-            }));
-        }
+        println!(
+            "k sweep {variant:<44} k {k:>5} {amount:>9} paths  relMSE {:.5}",
+            r.regions[0].errors.relmse
+        );
+        ev.sweep.push(SweepResult {
+            variant: variant.to_string(),
+            k,
+            photons: amount,
+            rung: r,
+        });
         Ok::<(), String>(())
     };
-    for (name, kernel, topo, boundary) in variants {
+    for (name, kernel, topo, boundary) in SWEEP_VARIANTS {
         for &k in ks {
             let o = Overrides {
                 method: Some(Method::GlobalDirect),
@@ -468,14 +549,9 @@ fn k_sweep(
                 boundary: Some(boundary),
                 ..Overrides::default()
             };
-            sweep(md, format!("{name} | {k}"), o, photons)?;
+            sweep(name, o, k, photons)?;
         }
     }
-    let _ = writeln!(
-        md,
-        "\n## Photons and k grown together (Silverman, photons / k = 200)\n\n\
-         | kernel | k | region | bias^2 | variance | relMSE |\n|---|---|---|---|---|---|"
-    );
     for &k in ks {
         let o = Overrides {
             method: Some(Method::GlobalDirect),
@@ -483,13 +559,34 @@ fn k_sweep(
             kernel: Some(Kernel::Silverman),
             ..Overrides::default()
         };
-        let label = format!("Silverman, {} paths | {k}", 200 * k);
-        sweep(md, label, o, 200 * k as u64)?;
+        sweep(GROWN, o, k, (photons / 1000).max(1) * k as u64)?;
     }
     Ok(())
 }
 
-fn slug(s: &str) -> String {
+/// The sweep's series: kernel, topological test, boundary correction.
+pub const SWEEP_VARIANTS: [(&str, Kernel, Option<f32>, bool); 4] = [
+    ("box", Kernel::Uniform, None, false),
+    ("Silverman", Kernel::Silverman, None, false),
+    (
+        "Silverman + topological test",
+        Kernel::Silverman,
+        Some(0.1),
+        false,
+    ),
+    (
+        "Silverman + topological test + boundary",
+        Kernel::Silverman,
+        Some(0.1),
+        true,
+    ),
+];
+
+/// The series of the sweep whose photon count grows with k (Silverman, the fixed count's
+/// paths at k = 1000).
+pub const GROWN: &str = "Silverman, photons grown with k";
+
+pub fn slug(s: &str) -> String {
     s.chars()
         .map(|c| {
             if c.is_ascii_alphanumeric() {

@@ -168,6 +168,9 @@ pub struct Overrides {
     pub passes: Option<u32>,
     /// Caustic paths per splatting pass (`[estimate.splat] photons`).
     pub splat_photons: Option<u64>,
+    /// Whether splatted caustic paths go on past their first diffuse hit
+    /// (`[estimate.splat] indirect`).
+    pub splat_indirect: Option<bool>,
     /// Stop the progressive methods' passes once this many seconds have passed (after at
     /// least one); not a setting of the scene file, which records the passes made instead.
     pub time: Option<f64>,
@@ -249,6 +252,9 @@ impl Settings {
         }
         if let Some(n) = o.splat_photons {
             estimate.splat.photons = n;
+        }
+        if let Some(i) = o.splat_indirect {
+            estimate.splat.indirect = i;
         }
         if let Some(t) = o.time
             && !(t > 0.0 && t.is_finite())

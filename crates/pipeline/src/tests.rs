@@ -431,3 +431,30 @@ fn an_in_memory_stage_sees_the_same_photons_as_the_file_writer() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn the_rim_mask_marks_the_open_front_only() {
+    let s = cornell();
+    let b = s.geometry.bounds();
+    let band = 0.02 * (b.max - b.min).length();
+    let m = crate::worksheet::rim_mask(&s, band);
+    let (w, h) = (m.width, m.height);
+    assert!(m.count() > 500, "{} rim pixels", m.count());
+    // The box's open side faces the camera (at +z): every rim pixel sees a point within the
+    // band of that plane, and the inner edges at the back are not rim.
+    for y in 0..h {
+        for x in 0..w {
+            if m.pixels[y * w + x] {
+                let hit = s
+                    .geometry
+                    .intersect(&s.camera.ray(x as f32 + 0.5, y as f32 + 0.5))
+                    .unwrap();
+                assert!(
+                    b.max.z - hit.point.p.z < band,
+                    "({x}, {y}) at {}",
+                    hit.point.p
+                );
+            }
+        }
+    }
+}

@@ -519,6 +519,53 @@ pub fn edge_mask(scene: &Scene, band: f32) -> Mask {
     })
 }
 
+/// Pixels whose camera ray lands on a diffuse surface within `band` of the box's outer rim:
+/// an edge of a diffuse triangle that no other triangle touches (the open front of the box),
+/// where a density estimate's disc reaches past the surface (boundary bias). Edges are tested
+/// at their midpoints against every triangle: quadratic in the triangle count, which suits
+/// boxes, not million-triangle meshes.
+pub fn rim_mask(scene: &Scene, band: f32) -> Mask {
+    let cam = &scene.camera;
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let mesh = scene.geometry.mesh();
+    let b = scene.geometry.bounds();
+    let eps = 1e-5 * (b.max - b.min).length();
+    let mut rim: Vec<(Vec3, Vec3)> = Vec::new();
+    for t in 0..mesh.len() {
+        if !scene.is_diffuse(mesh.materials[t]) {
+            continue;
+        }
+        let v = mesh.vertices(t);
+        for i in 0..3 {
+            let (a, c) = (v[i], v[(i + 1) % 3]);
+            let mid = 0.5 * (a + c);
+            let touched = (0..mesh.len())
+                .any(|u| u != t && point_triangle_distance(mid, mesh.vertices(u)) < eps);
+            if !touched {
+                rim.push((a, c));
+            }
+        }
+    }
+    Mask::from_fn(w, h, |x, y| {
+        let Some(hit) = scene
+            .geometry
+            .intersect(&cam.ray(x as f32 + 0.5, y as f32 + 0.5))
+        else {
+            return false;
+        };
+        scene.is_diffuse(hit.material)
+            && rim
+                .iter()
+                .any(|&(a, c)| point_segment_distance(hit.point.p, a, c) < band)
+    })
+}
+
+fn point_segment_distance(p: Vec3, a: Vec3, b: Vec3) -> f32 {
+    let ab = b - a;
+    let t = ((p - a).dot(ab) / ab.length_squared().max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
+    (p - (a + t * ab)).length()
+}
+
 /// Distance from `p` to the triangle `t` (Ericson, Real-Time Collision Detection, §5.1.5).
 fn point_triangle_distance(p: Vec3, t: [Vec3; 3]) -> f32 {
     let [a, b, c] = t;
