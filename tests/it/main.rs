@@ -5,6 +5,11 @@
 //!   the light under the ceiling is reachable, camera rays behave).
 //! - `evidence`: bias^2 and variance apart from independent runs: zero bias for the path
 //!   tracer, a fixed-k estimate's bias growing with k at the caustic.
+//! - `hard_cases`: one table of numerically hard scenes (camera inside the glass sphere, the
+//!   light just under the ceiling, grazing rays, total internal reflection, caustic focus,
+//!   coincident photons, k above the photon count, the scene scaled by 1e-3 and 1e4,
+//!   degenerate triangles, a sphere of radius 1e-4, light power near the f32 limit): every
+//!   image finite, closed forms, flux and invariances where the scene allows a check.
 //! - `photons`: photon flux against the path tracer (caustic flux under the glass sphere) and
 //!   against the light power (closed furnace box).
 //! - `photon_maps`: the photon-map methods through the pipeline library, trace to image: the
@@ -18,6 +23,7 @@
 
 mod cornell;
 mod evidence;
+mod hard_cases;
 mod photon_maps;
 mod photons;
 mod splat;
