@@ -8,7 +8,8 @@
 //! - `hard_cases`: one table of numerically hard scenes (camera inside the glass sphere, the
 //!   light just under the ceiling, grazing rays, total internal reflection, caustic focus,
 //!   coincident photons, k above the photon count, the scene scaled by 1e-3 and 1e4,
-//!   degenerate triangles, a sphere of radius 1e-4, light power near the f32 limit): every
+//!   degenerate triangles, a sphere of radius 1e-4 (also seen up close), light power near the
+//!   f32 limit): every
 //!   image finite, closed forms, flux and invariances where the scene allows a check.
 //! - `photons`: photon flux against the path tracer (caustic flux under the glass sphere) and
 //!   against the light power (closed furnace box).
