@@ -9,8 +9,8 @@
 //!   light just under the ceiling, grazing rays, total internal reflection, caustic focus,
 //!   coincident photons, k above the photon count, the scene scaled by 1e-3 and 1e4,
 //!   degenerate triangles, a sphere of radius 1e-4 (also seen up close), light power near the
-//!   f32 limit): every
-//!   image finite, closed forms, flux and invariances where the scene allows a check.
+//!   f32 limit): every image finite, closed forms, flux and invariances where the scene
+//!   allows a check.
 //! - `photons`: photon flux against the path tracer (caustic flux under the glass sphere) and
 //!   against the light power (closed furnace box).
 //! - `photon_maps`: the photon-map methods through the pipeline library, trace to image: the
