@@ -337,6 +337,14 @@ fn parse_rect(s: &str) -> Result<[usize; 4], String> {
 }
 
 fn main() -> ExitCode {
+    // Ctrl-C (or a termination signal) removes the photon files being written before it
+    // ends the process, as the default action would, with the shell's code for SIGINT.
+    // Files already published are complete (they are renamed into place whole).
+    let _ = ctrlc::set_handler(|| {
+        let n = store::remove_live_temp_files();
+        eprintln!("interrupted: removed {n} unfinished photon file(s)");
+        std::process::exit(130);
+    });
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
