@@ -134,7 +134,7 @@ enum Cmd {
         out: PathBuf,
         #[arg(long, default_value = "out/cache")]
         cache: PathBuf,
-        #[arg(long)]
+        #[arg(long, value_parser = parse_threads)]
         threads: Option<usize>,
     },
     /// What accuracy costs in time, bias and variance apart: each technique over a ladder of
@@ -157,7 +157,7 @@ enum Cmd {
         quick: bool,
         #[arg(long, default_value = "out/evidence")]
         out: PathBuf,
-        #[arg(long)]
+        #[arg(long, value_parser = parse_threads)]
         threads: Option<usize>,
     },
     /// Trace the photon sets a scene needs into the cache (or reuse them).
@@ -172,7 +172,7 @@ enum Cmd {
         /// Cache directory of photon files.
         #[arg(long, default_value = "out/cache")]
         cache: PathBuf,
-        #[arg(long)]
+        #[arg(long, value_parser = parse_threads)]
         threads: Option<usize>,
         /// Trace even if the cache holds the sets.
         #[arg(long)]
@@ -186,7 +186,7 @@ enum Cmd {
         #[arg(long)]
         out: PathBuf,
         /// Exposure of the PNG in stops.
-        #[arg(long, default_value_t = 0.0)]
+        #[arg(long, default_value_t = 0.0, value_parser = parse_finite)]
         exposure: f32,
     },
     /// Error metrics of image A against reference B (linear EXR files).
@@ -217,13 +217,13 @@ struct ImageArgs {
     #[arg(long)]
     spp: Option<u32>,
     /// Worker threads (default: all cores). The image does not depend on it.
-    #[arg(long)]
+    #[arg(long, value_parser = parse_threads)]
     threads: Option<usize>,
     /// Output directory (default: out/<scene dir>-<scene stem>-<method>).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Exposure of the PNG in stops.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = parse_finite)]
     exposure: f32,
 }
 
@@ -328,6 +328,24 @@ fn render(scene: &Scene, req: RenderRequest) -> Result<(), String> {
     Ok(())
 }
 
+/// `--threads`: 0 would leave no worker, whatever the command does first (a cache hit too).
+fn parse_threads(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(0) => Err("must be at least 1".into()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// A number that must be finite (`--exposure`): NaN or infinity would make every pixel NaN.
+fn parse_finite(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(x) if x.is_finite() => Ok(x),
+        Ok(x) => Err(format!("{x} is not a finite number")),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
 fn parse_rect(s: &str) -> Result<[usize; 4], String> {
     let v: Vec<usize> = s
         .split(',')
@@ -348,15 +366,37 @@ fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
-            // clap prints help/version to stdout with exit 0, usage errors to stderr with 2.
-            let _ = e.print();
+            use clap::error::ErrorKind;
+            // clap prints help/version to stdout with exit 0; a usage error is one line here
+            // (clap's own spans several), on stderr with exit 2.
+            match e.kind() {
+                ErrorKind::DisplayHelp
+                | ErrorKind::DisplayVersion
+                | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                    let _ = e.print();
+                }
+                _ => {
+                    let text = e.to_string();
+                    let line: Vec<&str> = text
+                        .lines()
+                        .map(str::trim)
+                        .take_while(|l| {
+                            !l.starts_with("Usage:") && !l.starts_with("For more information")
+                        })
+                        .filter(|l| !l.is_empty())
+                        .collect();
+                    eprintln!("{} (see --help)", line.join(" "));
+                }
+            }
             return ExitCode::from(e.exit_code() as u8);
         }
     };
     match run(cli.cmd) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            // One line, whatever a library's message holds (a TOML error's excerpt, say).
+            let line: Vec<&str> = e.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+            eprintln!("error: {}", line.join("; "));
             ExitCode::FAILURE
         }
     }
