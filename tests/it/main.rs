@@ -1,6 +1,10 @@
 //! The one end-to-end test binary (matklad, "Delete Cargo Integration Tests"). One module per
 //! subject:
 //!
+//! - `bad_input`: one table of broken or hostile inputs (OBJ, MTL, scene files, EXR files,
+//!   flags, photon counts, temp files), each run through the command line in process: exit
+//!   code and a one-line message naming the file and the problem, or the output a valid input
+//!   must give.
 //! - `cornell`: ray casting on the worksheet scene as loaded from `scenes/` (BVH = brute force,
 //!   the light under the ceiling is reachable, camera rays behave).
 //! - `evidence`: bias^2 and variance apart from independent runs: zero bias for the path
@@ -16,6 +20,7 @@
 //! - `sppm`: progressive photon mapping converging to closed forms (square light, furnace) at
 //!   the rate its radius schedule predicts; snapshots, time budget, thread-count invariance.
 
+mod bad_input;
 mod cornell;
 mod evidence;
 mod photon_maps;
