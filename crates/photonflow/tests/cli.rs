@@ -571,3 +571,69 @@ fn composite_averages_runs_by_their_counts_and_refuses_other_views() {
     assert!(e.contains("view") && e.lines().count() == 1, "{e}");
     assert!(!bad.exists(), "nothing written");
 }
+
+/// Ctrl-C during `trace` removes the photon file being written and exits 130; after a
+/// kill -9 the stale temp file stays until the next trace in that cache, which removes it.
+#[cfg(unix)]
+#[test]
+fn interrupted_traces_leave_no_temp_files() {
+    let dir = Scratch::new("interrupt", &[]);
+    let cache = dir.0.join("cache");
+    let temps = || -> Vec<String> {
+        std::fs::read_dir(&cache)
+            .map(|d| {
+                d.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                    .filter(|n| n.contains(".tmp-"))
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    for signal in ["-INT", "-KILL"] {
+        // Far more paths than the test waits for: interrupted while writing.
+        let mut child = Command::new(env!("CARGO_BIN_EXE_photonflow"))
+            .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+            .args([
+                "trace",
+                "scenes/corner/corner.toml",
+                "--photons",
+                "100000000",
+            ])
+            .arg("--cache")
+            .arg(&cache)
+            .args(["--force", "--threads", "1"])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        let t0 = std::time::Instant::now();
+        while temps().is_empty() {
+            assert!(t0.elapsed().as_secs() < 60, "no temp file appeared");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let sent = Command::new("kill")
+            .arg(signal)
+            .arg(child.id().to_string())
+            .status()
+            .unwrap();
+        assert!(sent.success());
+        let status = child.wait().unwrap();
+        if signal == "-INT" {
+            assert_eq!(status.code(), Some(130), "{status:?}");
+            assert!(temps().is_empty(), "left behind: {:?}", temps());
+        } else {
+            assert_eq!(temps().len(), 1, "kill -9 leaves its temp file");
+        }
+    }
+    let o = photonflow(&[
+        "trace",
+        "scenes/corner/corner.toml",
+        "--photons",
+        "2000",
+        "--cache",
+        cache.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(temps().is_empty(), "stale temp file kept: {:?}", temps());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("an unfinished photon file of process"), "{e}");
+}
