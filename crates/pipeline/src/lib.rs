@@ -128,7 +128,7 @@ pub fn render(scene: &Scene, req: &RenderRequest) -> Result<RenderSummary, Strin
 /// size, every pixel finite (errors against NaN or infinity are undefined). Callers read it
 /// before they write anything, so a run that cannot succeed leaves no output.
 pub fn read_reference(scene: &Scene, p: &Path) -> Result<film::Image, String> {
-    let img = film::read_exr(p).map_err(|e| e.to_string())?;
+    let img = output::read_exr(p)?;
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     if (img.width, img.height) != (w, h) {
         return Err(format!(

@@ -211,8 +211,8 @@ fn remove_if_present(p: &Path) -> Result<(), String> {
 /// Refused: an image holding NaN or infinity (its errors would be NaN), and a mask that is
 /// empty or reaches outside the image (clipping it silently would measure another region).
 pub fn compare(a: &Path, b: &Path, mask: Option<[usize; 4]>) -> Result<film::Metrics, String> {
-    let ia = film::read_exr(a).map_err(|e| e.to_string())?;
-    let ib = film::read_exr(b).map_err(|e| e.to_string())?;
+    let ia = read_exr(a)?;
+    let ib = read_exr(b)?;
     for (p, img) in [(a, &ia), (b, &ib)] {
         let bad = img
             .data
@@ -244,4 +244,19 @@ pub fn compare(a: &Path, b: &Path, mask: Option<[usize; 4]>) -> Result<film::Met
         None => None,
     };
     film::metrics(&ia, &ib, mask.as_ref()).map_err(|e| e.to_string())
+}
+
+/// Reads a linear EXR a user named, refusing anything but a regular file before opening it
+/// (a FIFO would block the EXR reader forever).
+pub fn read_exr(p: &Path) -> Result<Image, String> {
+    match std::fs::metadata(p) {
+        Ok(m) if !m.is_file() => {
+            return Err(format!(
+                "{}: not a regular file (a directory, FIFO, socket or device)",
+                p.display()
+            ));
+        }
+        _ => {}
+    }
+    film::read_exr(p).map_err(|e| e.to_string())
 }
