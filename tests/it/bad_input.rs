@@ -7,7 +7,9 @@
 //!
 //! Each kind of issue 12's point 1 has cases here: panics, hangs, accepted bad values,
 //! partial output, messages, valid scenes refused and temporary files (a stale file from a
-//! dead process; Ctrl-C itself needs a process, see `store`'s temp-file test).
+//! dead process; Ctrl-C itself needs a process: the binary's own test `cli.rs` signals it).
+//! Every loader (OBJ, MTL, scene file, photon file, EXR) and every command's flags have cases
+//! too (the bench commands only with values refused before any timing starts).
 
 use film::Image;
 use std::path::Path;
@@ -37,6 +39,8 @@ struct Case {
     files: Vec<(&'static str, Input)>,
     /// Commands run first, each of which must succeed (`{d}` is the case's directory).
     setup: Vec<&'static str>,
+    /// Run after the setup commands: damages what they wrote (a cached photon file, say).
+    prepare: Option<fn(&Path)>,
     /// The command line (`{d}` is the case's directory), split on spaces.
     args: &'static str,
     code: u8,
@@ -107,11 +111,47 @@ fn absent(rel: &'static str) -> Option<Check> {
     }))
 }
 
+/// Nothing but empty directories at `rel`.
+fn no_files(rel: &'static str) -> Option<Check> {
+    Some(Box::new(move |d: &Path| {
+        fn files(p: &Path) -> usize {
+            std::fs::read_dir(p).map_or(0, |r| {
+                r.flatten()
+                    .map(|e| match e.file_type() {
+                        Ok(t) if t.is_dir() => files(&e.path()),
+                        _ => 1,
+                    })
+                    .sum()
+            })
+        }
+        assert_eq!(files(&d.join(rel)), 0, "{rel} holds files");
+    }))
+}
+
 fn present(rel: &'static str, holds: &'static str) -> Option<Check> {
     Some(Box::new(move |d: &Path| {
         let t = std::fs::read_to_string(d.join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
         assert!(t.contains(holds), "{rel} does not hold `{holds}`: {t}");
     }))
+}
+
+/// The one photon file of the case's cache, replaced by what `f` makes of its bytes (or a
+/// FIFO for `None`).
+fn damage_photons(d: &Path, f: impl Fn(Vec<u8>) -> Option<Vec<u8>>) {
+    let file = std::fs::read_dir(d.join("cache"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|x| x == "photons"))
+        .expect("a traced photon file");
+    let bytes = std::fs::read(&file).unwrap();
+    std::fs::remove_file(&file).unwrap();
+    match f(bytes) {
+        Some(b) => std::fs::write(&file, b).unwrap(),
+        None => {
+            let made = std::process::Command::new("mkfifo").arg(&file).status();
+            assert!(made.is_ok_and(|s| s.success()));
+        }
+    }
 }
 
 fn cases() -> Vec<Case> {
@@ -123,6 +163,285 @@ fn cases() -> Vec<Case> {
     let black = MTL.replace("Kd 0.5 0.5 0.5", "Kd 0 0 0");
     let mirror = MTL.replace("Kd 0.5 0.5 0.5", "illum 3\nKs 0.9 0.9 0.9");
     vec![
+        // The photon file (a traced cache, then damaged): estimate names the file.
+        Case {
+            name: "a photon file with a flipped header byte",
+            files: good(),
+            setup: vec!["trace {d}/s.toml --photons 2000 --cache {d}/cache"],
+            prepare: Some(|d| {
+                damage_photons(d, |mut b| {
+                    b[40] ^= 0xff;
+                    Some(b)
+                })
+            }),
+            args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["-global.photons", "checksum mismatch in the header"],
+            check: absent("out"),
+        },
+        Case {
+            name: "a truncated photon file",
+            files: good(),
+            setup: vec!["trace {d}/s.toml --photons 2000 --cache {d}/cache"],
+            prepare: Some(|d| damage_photons(d, |b| Some(b[..100].to_vec()))),
+            args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["-global.photons", "truncated"],
+            check: absent("out"),
+        },
+        Case {
+            name: "a photon file of foreign bytes",
+            files: good(),
+            setup: vec!["trace {d}/s.toml --photons 2000 --cache {d}/cache"],
+            prepare: Some(|d| damage_photons(d, |_| Some(b"not photons at all".to_vec()))),
+            args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["-global.photons", "not a photon file"],
+            check: absent("out"),
+        },
+        Case {
+            name: "a photon file that is a FIFO",
+            files: good(),
+            setup: vec!["trace {d}/s.toml --photons 2000 --cache {d}/cache"],
+            prepare: Some(|d| damage_photons(d, |_| None)),
+            args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["-global.photons", "not a regular file"],
+            check: absent("out"),
+        },
+        Case {
+            name: "estimate without a traced cache",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["-global.photons", "run `trace` first"],
+            check: absent("out"),
+        },
+        // EXR files.
+        Case {
+            name: "compare on bytes that are not EXR",
+            files: vec![
+                ("a.exr", text("garbage")),
+                ("b.exr", Input::Exr(grey(16, 16))),
+            ],
+            setup: vec![],
+            prepare: None,
+            args: "compare {d}/a.exr {d}/b.exr",
+            code: 1,
+            words: &["a.exr", "EXR error"],
+            check: None,
+        },
+        Case {
+            name: "a truncated EXR reference",
+            files: with(good(), "ref.exr", Input::Exr(grey(16, 16))),
+            setup: vec![],
+            prepare: Some(|d| {
+                let p = d.join("ref.exr");
+                let b = std::fs::read(&p).unwrap();
+                std::fs::write(&p, &b[..b.len() / 2]).unwrap();
+            }),
+            args: "render {d}/s.toml --method path --spp 1 --out {d}/out --reference {d}/ref.exr",
+            code: 1,
+            words: &["ref.exr", "EXR error"],
+            check: absent("out"),
+        },
+        Case {
+            name: "an EXR that is a FIFO",
+            files: vec![("a.exr", Input::Fifo), ("b.exr", Input::Exr(grey(16, 16)))],
+            setup: vec![],
+            prepare: None,
+            args: "compare {d}/a.exr {d}/b.exr",
+            code: 1,
+            words: &["a.exr", "not a regular file"],
+            check: None,
+        },
+        Case {
+            name: "compare of two sizes",
+            files: vec![
+                ("a.exr", Input::Exr(grey(16, 16))),
+                ("b.exr", Input::Exr(grey(8, 8))),
+            ],
+            setup: vec![],
+            prepare: None,
+            args: "compare {d}/a.exr {d}/b.exr",
+            code: 1,
+            words: &["16x16", "8x8"],
+            check: None,
+        },
+        // Every command's flags.
+        Case {
+            name: "info on a missing scene",
+            files: vec![],
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/none.toml",
+            code: 1,
+            words: &["none.toml", "cannot read scene file"],
+            check: None,
+        },
+        Case {
+            name: "trace --photons 0",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "trace {d}/s.toml --photons 0 --cache {d}/cache",
+            code: 1,
+            words: &["s.toml", "photons = 0 must be in 1..=2^40"],
+            check: absent("cache"),
+        },
+        Case {
+            name: "render --k 0",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method global-direct --k 0 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["s.toml", "estimate.global.k = 0"],
+            check: absent("out"),
+        },
+        Case {
+            name: "render --topo 2",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method global-direct --topo 2 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["s.toml", "estimate.global.topo = 2 must be in (0, 1]"],
+            check: absent("out"),
+        },
+        Case {
+            name: "render --kernel of no name",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --kernel nope --out {d}/out",
+            code: 2,
+            words: &["--kernel", "unknown kernel `nope`"],
+            check: absent("out"),
+        },
+        Case {
+            name: "render --method of no name",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method nope --out {d}/out",
+            code: 2,
+            words: &["--method", "unknown method `nope`"],
+            check: absent("out"),
+        },
+        Case {
+            name: "render --time -1",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method sppm --time=-1 --out {d}/out",
+            code: 1,
+            words: &["--time -1 must be a positive number of seconds"],
+            check: absent("out"),
+        },
+        Case {
+            name: "render --passes 0",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method sppm --passes 0 --out {d}/out",
+            code: 1,
+            words: &["s.toml", "passes = 0"],
+            check: absent("out"),
+        },
+        Case {
+            name: "render --gather-rays absurd",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method final-gather --gather-rays 100000000 --out {d}/out",
+            code: 1,
+            words: &["s.toml", "final_gather.rays = 100000000 is absurd"],
+            check: absent("out"),
+        },
+        Case {
+            name: "render --spp 0",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method path --spp 0 --out {d}/out",
+            code: 1,
+            words: &["s.toml", "render.spp = 0"],
+            check: absent("out"),
+        },
+        Case {
+            name: "estimate --method path",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "estimate {d}/s.toml --method path --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["estimate reads photon maps", "render --method path"],
+            check: absent("out"),
+        },
+        Case {
+            name: "composite of a directory that is no run",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "composite {d} --out {d}/out",
+            code: 1,
+            words: &["image.json", "cannot read"],
+            check: absent("out"),
+        },
+        Case {
+            name: "worksheet --topo nan",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "worksheet --scene {d}/s.toml --topo nan --reference-spp 1 --out {d}/out --cache {d}/cache",
+            code: 1,
+            words: &["s.toml", "topo = NaN must be in (0, 1]"],
+            check: absent("out"),
+        },
+        Case {
+            name: "worksheet --k 0",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "worksheet --scene {d}/s.toml --k 0 --reference-spp 1 --out {d}/out --cache {d}/cache",
+            code: 1,
+            words: &["s.toml", "estimate.global.k = 0"],
+            check: absent("out"),
+        },
+        Case {
+            name: "evidence --seeds 1",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "evidence {d}/s.toml --seeds 1 --out {d}/out",
+            code: 1,
+            words: &["--seeds 1 must be at least 2"],
+            check: absent("out"),
+        },
+        Case {
+            name: "evidence with a reference of the wrong size",
+            files: with(good(), "ref.exr", Input::Exr(grey(16, 8))),
+            setup: vec![],
+            prepare: None,
+            args: "evidence {d}/s.toml --quick --reference {d}/ref.exr --out {d}/out",
+            code: 1,
+            words: &["ref.exr", "reference is 16x8"],
+            // evidence makes its (empty) directory before it reads the reference.
+            check: no_files("out"),
+        },
+        Case {
+            name: "bench-accuracy --peer without a command",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "bench-accuracy {d}/s.toml --peer bad --dir {d}/out",
+            code: 2,
+            words: &["--peer", "expected NAME=COMMAND"],
+            check: absent("out"),
+        },
         // Panics.
         Case {
             name: "MTL colour of one number is grey",
@@ -132,6 +451,7 @@ fn cases() -> Vec<Case> {
                 text(MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.5")),
             ),
             setup: vec![],
+            prepare: None,
             args: "info {d}/s.toml",
             code: 0,
             words: &[],
@@ -145,6 +465,7 @@ fn cases() -> Vec<Case> {
                 text(MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.5 0.5")),
             ),
             setup: vec![],
+            prepare: None,
             args: "info {d}/s.toml",
             code: 1,
             words: &[
@@ -163,6 +484,7 @@ fn cases() -> Vec<Case> {
                 text("mtllib m.mtl\no big\nusemtl white\nv -1 0 -1\nv -1 0 1\nv 1 0 1\nf 1 2 3\n"),
             ),
             setup: vec![],
+            prepare: None,
             args: "info {d}/s.toml",
             code: 1,
             words: &[
@@ -178,6 +500,7 @@ fn cases() -> Vec<Case> {
             name: "a convex face of 200k vertices",
             files: with(good(), "a.obj", text(polygon_obj(200_000, false))),
             setup: vec![],
+            prepare: None,
             args: "info {d}/s.toml",
             code: 0,
             words: &[],
@@ -187,6 +510,7 @@ fn cases() -> Vec<Case> {
             name: "a non-convex face of 200k vertices",
             files: with(good(), "a.obj", text(polygon_obj(200_000, true))),
             setup: vec![],
+            prepare: None,
             args: "info {d}/s.toml",
             code: 1,
             words: &[
@@ -201,6 +525,7 @@ fn cases() -> Vec<Case> {
             name: "a mesh that is a FIFO",
             files: with(good(), "a.obj", Input::Fifo),
             setup: vec![],
+            prepare: None,
             args: "info {d}/s.toml",
             code: 1,
             words: &["a.obj", "not a regular file", "s.toml"],
@@ -210,6 +535,7 @@ fn cases() -> Vec<Case> {
             name: "a scene file that is a FIFO",
             files: vec![("s.toml", Input::Fifo)],
             setup: vec![],
+            prepare: None,
             args: "render {d}/s.toml",
             code: 1,
             words: &["s.toml", "not a regular file"],
@@ -219,6 +545,7 @@ fn cases() -> Vec<Case> {
             name: "photon files that could never fit",
             files: good(),
             setup: vec![],
+            prepare: None,
             args: "trace {d}/s.toml --photons 1000000000000 --cache {d}/cache",
             code: 1,
             words: &[
@@ -234,6 +561,7 @@ fn cases() -> Vec<Case> {
             name: "r_max negative",
             files: files(global("r_max = -1.0"), OBJ, MTL),
             setup: vec![],
+            prepare: None,
             args: "render {d}/s.toml --method global-direct --photons 2000 --cache {d}/cache --out {d}/out",
             code: 1,
             words: &["s.toml", "estimate.global.r_max = -1 must be positive"],
@@ -243,6 +571,7 @@ fn cases() -> Vec<Case> {
             name: "r_max NaN",
             files: files(global("r_max = nan"), OBJ, MTL),
             setup: vec![],
+            prepare: None,
             args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out",
             code: 1,
             words: &["s.toml", "r_max = NaN must be positive"],
@@ -252,6 +581,7 @@ fn cases() -> Vec<Case> {
             name: "NaN exposure",
             files: good(),
             setup: vec![],
+            prepare: None,
             args: "render {d}/s.toml --method path --spp 1 --out {d}/out --exposure NaN",
             code: 2,
             words: &["--exposure", "NaN is not a finite number"],
@@ -261,6 +591,7 @@ fn cases() -> Vec<Case> {
             name: "infinite exposure of composite",
             files: good(),
             setup: vec!["render {d}/s.toml --method path --spp 1 --out {d}/run"],
+            prepare: None,
             args: "composite {d}/run --out {d}/out --exposure inf",
             code: 2,
             words: &["--exposure", "inf is not a finite number"],
@@ -270,6 +601,7 @@ fn cases() -> Vec<Case> {
             name: "--threads 0 when the cache answers",
             files: good(),
             setup: vec!["trace {d}/s.toml --photons 2000 --cache {d}/cache"],
+            prepare: None,
             args: "trace {d}/s.toml --photons 2000 --cache {d}/cache --threads 0",
             code: 2,
             words: &["--threads", "must be at least 1"],
@@ -279,6 +611,7 @@ fn cases() -> Vec<Case> {
             name: "--threads 0 of estimate",
             files: good(),
             setup: vec!["trace {d}/s.toml --photons 2000 --cache {d}/cache"],
+            prepare: None,
             args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out --threads 0",
             code: 2,
             words: &["--threads", "must be at least 1"],
@@ -288,6 +621,7 @@ fn cases() -> Vec<Case> {
             name: "--reference with --method path is used",
             files: with(good(), "ref.exr", Input::Exr(grey(16, 16))),
             setup: vec![],
+            prepare: None,
             args: "render {d}/s.toml --method path --spp 1 --out {d}/out --reference {d}/ref.exr",
             code: 0,
             words: &[],
@@ -300,6 +634,7 @@ fn cases() -> Vec<Case> {
                 ("b.exr", Input::Exr(grey(16, 16))),
             ],
             setup: vec![],
+            prepare: None,
             args: "compare {d}/a.exr {d}/b.exr",
             code: 1,
             words: &["a.exr", "3 of 256 pixels are not finite"],
@@ -312,6 +647,7 @@ fn cases() -> Vec<Case> {
                 ("b.exr", Input::Exr(grey(16, 16))),
             ],
             setup: vec![],
+            prepare: None,
             args: "compare {d}/a.exr {d}/b.exr --mask 0,0,40,8",
             code: 1,
             words: &["a.exr", "--mask 0,0,40,8", "16x16"],
@@ -321,6 +657,7 @@ fn cases() -> Vec<Case> {
             name: "a mask of the wrong shape",
             files: vec![],
             setup: vec![],
+            prepare: None,
             args: "compare {d}/a.exr {d}/b.exr --mask 1,2",
             code: 2,
             words: &["--mask", "expected x0,y0,x1,y1"],
@@ -331,6 +668,7 @@ fn cases() -> Vec<Case> {
             name: "a missing reference",
             files: good(),
             setup: vec![],
+            prepare: None,
             args: "render {d}/s.toml --method path --spp 1 --out {d}/out --reference {d}/none.exr",
             code: 1,
             words: &["none.exr"],
@@ -340,6 +678,7 @@ fn cases() -> Vec<Case> {
             name: "a reference of the wrong size",
             files: with(good(), "ref.exr", Input::Exr(grey(8, 16))),
             setup: vec![],
+            prepare: None,
             args: "render {d}/s.toml --method sppm --photons 2000 --out {d}/out --reference {d}/ref.exr",
             code: 1,
             words: &["ref.exr", "reference is 8x16, the scene renders 16x16"],
@@ -357,6 +696,7 @@ fn cases() -> Vec<Case> {
                 }),
             ),
             setup: vec![],
+            prepare: None,
             args: "render {d}/s.toml --method path --spp 1 --out {d}/out --reference {d}/ref.exr",
             code: 1,
             words: &["ref.exr", "1 of 256 reference pixels are not finite"],
@@ -366,6 +706,7 @@ fn cases() -> Vec<Case> {
             name: "bench accuracy with a reference of the wrong size",
             files: with(good(), "ref.exr", Input::Exr(grey(16, 8))),
             setup: vec![],
+            prepare: None,
             args: "bench-accuracy {d}/s.toml --reference {d}/ref.exr --dir {d}/out",
             code: 1,
             words: &["ref.exr", "reference is 16x8"],
@@ -376,6 +717,7 @@ fn cases() -> Vec<Case> {
             name: "an empty OBJ",
             files: with(good(), "a.obj", text("")),
             setup: vec![],
+            prepare: None,
             args: "info {d}/s.toml",
             code: 1,
             words: &["a.obj", "the OBJ file is empty", "s.toml"],
@@ -385,6 +727,7 @@ fn cases() -> Vec<Case> {
             name: "an OBJ without mtllib",
             files: with(good(), "a.obj", text(OBJ.replace("mtllib m.mtl\n", ""))),
             setup: vec![],
+            prepare: None,
             args: "info {d}/s.toml",
             code: 1,
             words: &[
@@ -403,6 +746,7 @@ fn cases() -> Vec<Case> {
                 text(OBJ.replace("usemtl light", "usemtl lamp")),
             ),
             setup: vec![],
+            prepare: None,
             args: "info {d}/s.toml",
             code: 1,
             words: &[
@@ -417,6 +761,7 @@ fn cases() -> Vec<Case> {
             name: "faces before any usemtl",
             files: with(good(), "a.obj", text(OBJ.replace("usemtl white\n", ""))),
             setup: vec![],
+            prepare: None,
             args: "info {d}/s.toml",
             code: 1,
             words: &[
@@ -430,6 +775,7 @@ fn cases() -> Vec<Case> {
             name: "a malformed scene file spans one line",
             files: vec![("s.toml", text("[camera\neye = 1\n"))],
             setup: vec![],
+            prepare: None,
             args: "info {d}/s.toml",
             code: 1,
             words: &["s.toml", "malformed scene file", "line 1"],
@@ -439,6 +785,7 @@ fn cases() -> Vec<Case> {
             name: "an unknown flag spans one line",
             files: vec![],
             setup: vec![],
+            prepare: None,
             args: "render {d}/s.toml --bogus",
             code: 2,
             words: &["--bogus", "(see --help)"],
@@ -449,6 +796,7 @@ fn cases() -> Vec<Case> {
             name: "all surfaces black, final gathering",
             files: files(scene(""), OBJ, &black),
             setup: vec![],
+            prepare: None,
             args: "render {d}/s.toml --method final-gather --photons 2000 --cache {d}/cache --out {d}/out",
             code: 0,
             words: &[],
@@ -458,6 +806,7 @@ fn cases() -> Vec<Case> {
             name: "only mirrors, final gathering",
             files: files(scene(""), OBJ, &mirror),
             setup: vec![],
+            prepare: None,
             args: "render {d}/s.toml --method final-gather --photons 2000 --cache {d}/cache --out {d}/out",
             code: 0,
             words: &[],
@@ -470,6 +819,7 @@ fn cases() -> Vec<Case> {
             name: "only mirrors, sppm",
             files: files(scene(""), OBJ, &mirror),
             setup: vec![],
+            prepare: None,
             args: "render {d}/s.toml --method sppm --photons 2000 --out {d}/out",
             code: 0,
             words: &[],
@@ -480,6 +830,7 @@ fn cases() -> Vec<Case> {
             name: "a stale temp file of a dead process",
             files: with(good(), "cache/x.photons.tmp-999999999-0", text("partial")),
             setup: vec![],
+            prepare: None,
             args: "trace {d}/s.toml --photons 2000 --cache {d}/cache",
             code: 0,
             words: &[],
@@ -532,6 +883,9 @@ fn bad_input_table() {
                 Some(Ok((0, _))) => {}
                 other => panic!("{}: setup `{s}` failed: {other:?}", case.name),
             }
+        }
+        if let Some(prepare) = case.prepare {
+            prepare(&dir);
         }
         let what = match run(case.args, &dir) {
             None => Err("hung (no answer in 120 s)".to_string()),
