@@ -1,5 +1,8 @@
 //! Shared helpers of the end-to-end tests (`it/`).
 
+pub mod alloc;
+pub mod fuzz;
+
 use std::path::{Path, PathBuf};
 
 /// The repository's `scenes/` directory.

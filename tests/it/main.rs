@@ -1,6 +1,10 @@
 //! The one end-to-end test binary (matklad, "Delete Cargo Integration Tests"). One module per
 //! subject:
 //!
+//! - `bad_input`: one table of broken or hostile inputs (OBJ, MTL, scene files, EXR files,
+//!   flags, photon counts, temp files), each run through the command line in process: exit
+//!   code and a one-line message naming the file and the problem, or the output a valid input
+//!   must give.
 //! - `cornell`: ray casting on the worksheet scene as loaded from `scenes/` (BVH = brute force,
 //!   the light under the ceiling is reachable, camera rays behave).
 //! - `evidence`: bias^2 and variance apart from independent runs: zero bias for the path
@@ -19,11 +23,19 @@
 //! - `splat`: photon differential splatting through the pipeline library: the splatted
 //!   caustic and `path+splat` against the path tracer on the worksheet scene, bounded chunks
 //!   in flight, a hostile scene (finite pixels, flux kept), the same bits on 1 and 2 threads.
+//! - `fuzz`: the fuzz loops of `tests::fuzz` over every loader (mutated OBJ, MTL, scene,
+//!   photon and EXR files: no panic, hang or header-sized allocation).
 //! - `sppm`: progressive photon mapping converging to closed forms (square light, furnace) at
 //!   the rate its radius schedule predicts; snapshots, time budget, thread-count invariance.
 
+// Per-thread largest allocation, for the fuzz loops' check.
+#[global_allocator]
+static ALLOC: tests::alloc::Tracking = tests::alloc::Tracking;
+
+mod bad_input;
 mod cornell;
 mod evidence;
+mod fuzz;
 mod hard_cases;
 mod photon_maps;
 mod photons;

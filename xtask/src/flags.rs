@@ -58,11 +58,16 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
                       k-NN queries/s for k = 50, 250, 1000 per index (kd-tree, kiddo, brute),
                       and pixel-order irradiance queries with radius hints
   gen-scenes          rewrite the generated OBJ/MTL files under scenes/
+  fuzz [--seconds N] [--target obj|mtl|scene|photons|exr] [--seed S]
+                      mutate valid files and feed them to each loader for N seconds per target
+                      (default 60): no panic, no hang, no allocation sized by a header field
 ";
 
 pub enum Cmd {
     Help,
     GenScenes,
+    /// The fuzz loops (`tests/bin/fuzz.rs`), with these arguments.
+    Fuzz(Vec<String>),
     /// Arguments passed straight to the photonflow binary (release build).
     Photonflow(Vec<String>),
     /// A benchmark: built with the `release-lto` profile, its output recorded in
@@ -88,6 +93,7 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
     match a.as_slice() {
         [] | ["help" | "-h" | "--help", ..] => Ok(Cmd::Help),
         ["gen-scenes"] => Ok(Cmd::GenScenes),
+        ["fuzz", rest @ ..] => Ok(Cmd::Fuzz(rest.iter().map(|s| s.to_string()).collect())),
         [
             cmd @ ("info" | "render" | "compare" | "composite" | "trace" | "estimate" | "worksheet"
             | "evidence"),

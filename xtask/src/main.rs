@@ -33,6 +33,7 @@ fn run(args: &[String]) -> Result<(), String> {
             Ok(())
         }
         flags::Cmd::GenScenes => gen_scenes::run(&project_root()),
+        flags::Cmd::Fuzz(args) => fuzz(&args),
         flags::Cmd::Photonflow(args) => photonflow(&build("release")?, &args),
         // `release-lto` is the profile published numbers use.
         flags::Cmd::Bench(bench) => {
@@ -74,6 +75,31 @@ fn build(profile: &str) -> Result<PathBuf, String> {
     Ok(target
         .join(profile)
         .join(format!("photonflow{}", std::env::consts::EXE_SUFFIX)))
+}
+
+/// The fuzz loops, optimised (they run as many cases as the seconds allow).
+fn fuzz(args: &[String]) -> Result<(), String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let status = Command::new(&cargo)
+        .current_dir(project_root())
+        .args([
+            "run",
+            "--quiet",
+            "--release",
+            "-p",
+            "tests",
+            "--bin",
+            "fuzz",
+            "--",
+        ])
+        .args(args)
+        .status()
+        .map_err(|e| format!("cannot run {cargo}: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("fuzz {} failed ({status})", args.join(" ")))
+    }
 }
 
 /// Run the built binary `exe` with `args` from the project root.

@@ -104,6 +104,15 @@ impl Plan {
         if !global && !caustic {
             reasons.push("photon tracing: skipped (no photon set to fill)".to_string());
         }
+        if diffuse.is_empty() {
+            // A valid scene, and its image is well defined: say what it holds.
+            reasons.push(
+                "image: no surface is diffuse (all black or specular), so direct light, \
+                 caustics and indirect light are black everywhere; only emitters, seen directly \
+                 or through specular surfaces, show"
+                    .to_string(),
+            );
+        }
         Ok(Plan {
             global,
             caustic,

@@ -5,6 +5,20 @@
 //! POSIX file systems, so readers (and a later run after a crash) see either the old file
 //! or the complete new one, never a truncated image.
 
+// A decoder of untrusted bytes: no input may reach a panic, so the lints that find the ways
+// to one (unwrap, expect, indexing, explicit panics) are errors here; `cargo clippy` is the
+// check.
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::indexing_slicing,
+        clippy::panic,
+        clippy::unreachable
+    )
+)]
+
 use std::fs;
 use std::io::{Cursor, Write};
 use std::path::{Path, PathBuf};
@@ -54,8 +68,8 @@ pub fn write_exr(path: impl AsRef<Path>, img: &Image) -> Result<(), FilmError> {
     img.check("write_exr")?;
     let w = img.width;
     let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
-        let p = img.data[y * w + x];
-        (p[0], p[1], p[2])
+        let [r, g, b] = img.data.get(y * w + x).copied().unwrap_or_default();
+        (r, g, b)
     });
     let image = exr::prelude::Image::from_encoded_channels(
         (img.width, img.height),
@@ -76,12 +90,42 @@ pub fn write_exr(path: impl AsRef<Path>, img: &Image) -> Result<(), FilmError> {
 /// Reads the first RGB(A) layer of an OpenEXR file as linear f32 RGB (alpha is dropped).
 pub fn read_exr(path: impl AsRef<Path>) -> Result<Image, FilmError> {
     let path = path.as_ref();
+    let exr_err = |source| FilmError::Exr {
+        path: path.to_owned(),
+        source,
+    };
+    // The image is allocated from the header's size: check that size against what the file
+    // could hold first. Deflate, EXR's strongest lossless stage, expands at most 1032:1
+    // (RFC 1951: a 258-byte match per 2 bits), so a pixel of three f32 channels needs over
+    // 1/100 byte; 128 pixels per byte, plus a million pixels, is room for any real file.
+    let len = fs::metadata(path)
+        .map_err(|source| FilmError::Io {
+            path: path.to_owned(),
+            what: "read",
+            source,
+        })?
+        .len();
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(exr_err)?;
+    for h in &meta.headers {
+        let pixels = (h.layer_size.width() as u64).saturating_mul(h.layer_size.height() as u64);
+        if pixels > len.saturating_mul(128).saturating_add(1 << 20) {
+            return Err(exr_err(exr::error::Error::Invalid(
+                std::borrow::Cow::Owned(format!(
+                    "a {}x{} layer cannot fit in a {len}-byte file",
+                    h.layer_size.width(),
+                    h.layer_size.height()
+                )),
+            )));
+        }
+    }
     let read = exr::prelude::read_first_rgba_layer_from_file(
         path,
         |size, _| Image::new(size.width(), size.height()),
         |img: &mut Image, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            let w = img.width;
-            img.data[pos.y() * w + pos.x()] = [r, g, b];
+            let i = pos.y() * img.width + pos.x();
+            if let Some(p) = img.data.get_mut(i) {
+                *p = [r, g, b];
+            }
         },
     )
     .map_err(|source| FilmError::Exr {

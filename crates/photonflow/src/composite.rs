@@ -105,6 +105,10 @@ fn refuse_overwriting_an_input(dirs: &[PathBuf], out: &Path) -> Result<(), Strin
 /// One run: its `image.json` and the EXR of each layer it lists.
 fn load(dir: &Path) -> Result<::composite::Input, String> {
     let json_path = dir.join("image.json");
+    // Only regular files are opened: a FIFO would block.
+    if std::fs::metadata(&json_path).is_ok_and(|m| !m.is_file()) {
+        return Err(format!("{}: not a regular file", json_path.display()));
+    }
     let text = std::fs::read_to_string(&json_path)
         .map_err(|e| format!("{}: cannot read: {e}", json_path.display()))?;
     let meta =
@@ -113,7 +117,7 @@ fn load(dir: &Path) -> Result<::composite::Input, String> {
     for l in &meta.layers {
         // Layer names are checked to be plain file names ([A-Za-z0-9_-]+) by `from_json`.
         let path = dir.join("layers").join(format!("{}.exr", l.name));
-        let img = film::read_exr(&path).map_err(|e| e.to_string())?;
+        let img = pipeline::output::read_exr(&path)?;
         layers.push((l.name.clone(), img));
     }
     Ok(::composite::Input {

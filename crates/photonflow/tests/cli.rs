@@ -571,3 +571,90 @@ fn composite_averages_runs_by_their_counts_and_refuses_other_views() {
     assert!(e.contains("view") && e.lines().count() == 1, "{e}");
     assert!(!bad.exists(), "nothing written");
 }
+
+/// Ctrl-C during `trace` removes the photon file being written and exits 130; after a
+/// kill -9 the stale temp file stays until the next trace in that cache, which removes it.
+#[cfg(unix)]
+#[test]
+fn interrupted_traces_leave_no_temp_files() {
+    let dir = Scratch::new("interrupt", &[]);
+    let cache = dir.0.join("cache");
+    let names = || -> Vec<String> {
+        std::fs::read_dir(&cache)
+            .map(|d| {
+                d.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let temps = || -> Vec<String> {
+        names()
+            .into_iter()
+            .filter(|n| n.contains(".tmp-"))
+            .collect()
+    };
+    // SIGINT and SIGKILL, each at several moments while the photon files are being written
+    // (0 to 0.6 s after the first temporary file appears; the trace would take minutes).
+    for (i, signal) in ["-INT", "-KILL", "-INT", "-KILL", "-KILL", "-INT"]
+        .iter()
+        .enumerate()
+    {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_photonflow"))
+            .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+            .args([
+                "trace",
+                "scenes/corner/corner.toml",
+                "--photons",
+                "100000000",
+            ])
+            .arg("--cache")
+            .arg(&cache)
+            .args(["--force", "--threads", "1"])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        let t0 = std::time::Instant::now();
+        let mine = format!(".tmp-{}-", child.id());
+        while !temps().iter().any(|n| n.contains(&mine)) {
+            assert!(t0.elapsed().as_secs() < 60, "no temp file appeared");
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(120 * i as u64));
+        let sent = Command::new("kill")
+            .arg(signal)
+            .arg(child.id().to_string())
+            .status()
+            .unwrap();
+        assert!(sent.success());
+        let status = child.wait().unwrap();
+        // No photon file was published: the run never finished, so nothing in the cache may
+        // read as a photon set.
+        let published: Vec<String> = names()
+            .into_iter()
+            .filter(|n| !n.contains(".tmp-"))
+            .collect();
+        assert_eq!(published, Vec::<String>::new(), "{signal} at moment {i}");
+        if *signal == "-INT" {
+            // Its own temporary files removed on the signal, and a killed run's before it
+            // began (their process is gone).
+            assert_eq!(status.code(), Some(130), "{status:?}");
+            assert!(temps().is_empty(), "left behind: {:?}", temps());
+        } else {
+            // kill -9 cannot clean up: its temporary files stay until the next run.
+            assert!(temps().iter().any(|n| n.contains(&mine)), "{:?}", temps());
+        }
+    }
+    let o = photonflow(&[
+        "trace",
+        "scenes/corner/corner.toml",
+        "--photons",
+        "2000",
+        "--cache",
+        cache.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(temps().is_empty(), "stale temp file kept: {:?}", temps());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("an unfinished photon file of process"), "{e}");
+}

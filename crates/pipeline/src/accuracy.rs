@@ -66,6 +66,8 @@ pub(crate) fn reference(
     dir: &Path,
 ) -> Result<PathBuf, String> {
     if let Some(p) = given {
+        // Checked now, before any rung writes a run directory.
+        crate::read_reference(scene, p)?;
         return Ok(p.to_path_buf());
     }
     let cached = dir.join(format!("reference-{:016x}-{spp}spp", scene.view_hash));
@@ -75,6 +77,7 @@ pub(crate) fn reference(
         return Ok(exr);
     }
     println!("reference: rendering {spp} spp into {}", cached.display());
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     run_one(
         scene,
         Method::Path,
@@ -137,8 +140,8 @@ pub fn accuracy(
     dir: &Path,
 ) -> Result<(), String> {
     let scene = Scene::load(path).map_err(|e| e.to_string())?;
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let reference = reference(&scene, given_reference, reference_spp, dir)?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let cache = dir.join("cache");
     let mut table: Vec<(String, Vec<Rung>)> = Vec::new();
     let ladder = |name: &str, method: Method, budgets: &[u32], stop: Option<f64>| {

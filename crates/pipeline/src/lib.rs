@@ -85,19 +85,7 @@ pub fn render(scene: &Scene, req: &RenderRequest) -> Result<RenderSummary, Strin
         .unwrap_or_else(|| output::default_out(&scene.path, &label));
     // Everything that can refuse the run is checked before the render starts.
     let reference = match req.reference {
-        Some(p) => {
-            let img = film::read_exr(p).map_err(|e| e.to_string())?;
-            let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-            if (img.width, img.height) != (w, h) {
-                return Err(format!(
-                    "{}: reference is {}x{}, the scene renders {w}x{h}",
-                    p.display(),
-                    img.width,
-                    img.height
-                ));
-            }
-            Some((p, img))
-        }
+        Some(p) => Some((p, read_reference(scene, p)?)),
         None => None,
     };
     if !req.exposure.is_finite() {
@@ -136,6 +124,35 @@ pub fn render(scene: &Scene, req: &RenderRequest) -> Result<RenderSummary, Strin
         metrics,
         seconds,
     })
+}
+
+/// A reference image for `scene`, refused unless it can serve: readable, of the scene's
+/// size, every pixel finite (errors against NaN or infinity are undefined). Callers read it
+/// before they write anything, so a run that cannot succeed leaves no output.
+pub fn read_reference(scene: &Scene, p: &Path) -> Result<film::Image, String> {
+    let img = output::read_exr(p)?;
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    if (img.width, img.height) != (w, h) {
+        return Err(format!(
+            "{}: reference is {}x{}, the scene renders {w}x{h}",
+            p.display(),
+            img.width,
+            img.height
+        ));
+    }
+    let bad = img
+        .data
+        .iter()
+        .filter(|px| !px.iter().all(|c| c.is_finite()))
+        .count();
+    if bad > 0 {
+        return Err(format!(
+            "{}: {bad} of {} reference pixels are not finite (NaN or infinity)",
+            p.display(),
+            img.data.len()
+        ));
+    }
+    Ok(img)
 }
 
 /// Traces (or reuses) the photon sets `scene` needs into `cache`.

@@ -220,9 +220,55 @@ pub fn compare_flip(a: &Path, b: &Path, mask: Option<[usize; 4]>) -> Result<f64,
 }
 
 /// Error metrics of image `a` against reference `b` (linear EXR files), inside `mask`.
+/// Refused: an image holding NaN or infinity (its errors would be NaN), and a mask that is
+/// empty or reaches outside the image (clipping it silently would measure another region).
 pub fn compare(a: &Path, b: &Path, mask: Option<[usize; 4]>) -> Result<film::Metrics, String> {
-    let ia = film::read_exr(a).map_err(|e| e.to_string())?;
-    let ib = film::read_exr(b).map_err(|e| e.to_string())?;
-    let mask = mask.map(|[x0, y0, x1, y1]| Mask::rect(ia.width, ia.height, x0, y0, x1, y1));
+    let ia = read_exr(a)?;
+    let ib = read_exr(b)?;
+    for (p, img) in [(a, &ia), (b, &ib)] {
+        let bad = img
+            .data
+            .iter()
+            .filter(|px| !px.iter().all(|c| c.is_finite()))
+            .count();
+        if bad > 0 {
+            return Err(format!(
+                "{}: {bad} of {} pixels are not finite (NaN or infinity): errors against it \
+                 are undefined",
+                p.display(),
+                img.data.len()
+            ));
+        }
+    }
+    let mask = match mask {
+        Some([x0, y0, x1, y1]) => {
+            if !(x0 < x1 && y0 < y1 && x1 <= ia.width && y1 <= ia.height) {
+                return Err(format!(
+                    "{}: --mask {x0},{y0},{x1},{y1} is not a non-empty rectangle inside the \
+                     {}x{} image (x0 < x1 <= width, y0 < y1 <= height)",
+                    a.display(),
+                    ia.width,
+                    ia.height
+                ));
+            }
+            Some(Mask::rect(ia.width, ia.height, x0, y0, x1, y1))
+        }
+        None => None,
+    };
     film::metrics(&ia, &ib, mask.as_ref()).map_err(|e| e.to_string())
+}
+
+/// Reads a linear EXR a user named, refusing anything but a regular file before opening it
+/// (a FIFO would block the EXR reader forever).
+pub fn read_exr(p: &Path) -> Result<Image, String> {
+    match std::fs::metadata(p) {
+        Ok(m) if !m.is_file() => {
+            return Err(format!(
+                "{}: not a regular file (a directory, FIFO, socket or device)",
+                p.display()
+            ));
+        }
+        _ => {}
+    }
+    film::read_exr(p).map_err(|e| e.to_string())
 }

@@ -131,9 +131,19 @@ pub fn trace(
     let files: Vec<(MapKind, PathBuf)> = kinds.iter().map(|&k| (k, key.file(dir, k))).collect();
     std::fs::create_dir_all(dir)
         .map_err(|e| format!("{}: cannot create cache directory: {e}", dir.display()))?;
-    film::write_atomic(&key.plan_file(dir), plan.to_string().as_bytes())
-        .map_err(|e| e.to_string())?;
+    // A run killed mid-write (kill -9) left its temp files: no run will finish or read them.
+    for (f, pid) in store::remove_stale_temp_files(dir) {
+        eprintln!(
+            "removed {}: an unfinished photon file of process {pid}, which is gone",
+            f.display()
+        );
+    }
+    let write_plan = || {
+        film::write_atomic(&key.plan_file(dir), plan.to_string().as_bytes())
+            .map_err(|e| e.to_string())
+    };
     if !force && cached(dir, &key, &kinds) {
+        write_plan()?;
         println!("reused cached photon sets (no tracing):");
         for (_, f) in &files {
             println!("  {}", f.display());
@@ -146,6 +156,9 @@ pub fn trace(
             seconds: 0.0,
         });
     }
+    // Refused runs write nothing, the plan included.
+    check_space(scene, params, &plan, dir)?;
+    write_plan()?;
     let progress = Progress::new("trace", params.photons, "photons");
     let mut store = StoreSink::create(&files, &|k| key.header(scene, k))?;
     let stats = flow::run(
@@ -184,6 +197,37 @@ pub fn trace(
         reused: false,
         seconds: stats.seconds,
     })
+}
+
+/// Photon paths of the pilot that measures photons stored per path before a trace.
+const PILOT_PATHS: u64 = 4096;
+
+/// Refuses a trace whose photon files could not fit on the cache's file system, before any
+/// work: the first [`PILOT_PATHS`] paths of the run are traced to measure the photons stored
+/// per path, and the files' size projected from it (32-byte records; headers are noise).
+/// A run of 1e12 paths used to start tracing and fail days later, or fill the disk.
+fn check_space(scene: &Scene, params: &EmitParams, plan: &Plan, dir: &Path) -> Result<(), String> {
+    let Some(free) = store::free_space(dir) else {
+        return Ok(());
+    };
+    let pilot = params.photons.min(PILOT_PATHS);
+    let stored = emit::trace_range(scene, params, plan, 0..pilot).stored() as f64;
+    let per_path = stored / pilot as f64;
+    let record = std::mem::size_of::<store::Photon>() as f64;
+    let bytes = params.photons as f64 * per_path * record;
+    if bytes <= free as f64 {
+        return Ok(());
+    }
+    let limit = (free as f64 / (per_path * record)).floor();
+    Err(format!(
+        "{}: {} photon paths would write about {:.3e} bytes of photon files ({per_path:.2} \
+         photons per path over the first {pilot} paths, {record} bytes each), but {} has \
+         {free} bytes free: at most about {limit:.3e} paths fit",
+        scene.path.display(),
+        params.photons,
+        bytes,
+        dir.display()
+    ))
 }
 
 /// Most photons one map may hold: the kd-tree indexes with u32.

@@ -34,6 +34,23 @@ struct Variant {
 }
 
 pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
+    // The estimates' settings (--k, --topo, --photons) are checked before the reference is
+    // rendered: a bad value used to fail only after the reference and two estimates were
+    // written.
+    for topo in [None, Some(a.topo)] {
+        crate::Settings::new(
+            scene,
+            &Overrides {
+                method: Some(scene::Method::GlobalDirect),
+                photons: Some(a.photons),
+                spp: Some(1),
+                k: Some(a.k),
+                topo: Some(topo),
+                boundary: Some(topo.is_some()),
+                ..Overrides::default()
+            },
+        )?;
+    }
     std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
 
     // 1. The path-traced reference, reused when it was made with exactly these settings.

@@ -16,6 +16,7 @@ mod file;
 mod lights;
 mod load;
 mod material;
+mod polygon;
 mod world;
 
 pub use camera::Camera;

@@ -93,8 +93,10 @@ impl Scene {
         edit: impl FnOnce(&mut SceneFile),
     ) -> Result<Scene, SceneError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path)
+        let bytes = read_regular(path)
             .map_err(|e| SceneError::new(path, format!("cannot read scene file: {e}")))?;
+        let text = String::from_utf8(bytes)
+            .map_err(|_| SceneError::new(path, "cannot read scene file: it is not UTF-8 text"))?;
         Scene::from_toml_with(path, &text, edit)
     }
 
@@ -261,6 +263,13 @@ impl<'a> Builder<'a> {
                     s.center, s.radius
                 )));
             }
+            if c.abs().max_element() as f64 + s.radius as f64 > MAX_COORD {
+                return Err(self.err(format!(
+                    "sphere {i} (centre {:?}, radius {}) reaches beyond the {MAX_COORD:e} scene \
+                     units photonflow can trace",
+                    s.center, s.radius
+                )));
+            }
             let Some(&mat) = self.by_name.get(&s.material) else {
                 return Err(self.err(format!(
                     "sphere {i}: unknown material `{}` (known: {})",
@@ -415,7 +424,7 @@ impl<'a> Builder<'a> {
 
     fn load_mesh(&mut self, index: usize, desc: &MeshDesc) -> Result<(), SceneError> {
         let obj_path = self.dir.join(&desc.obj);
-        let bytes = std::fs::read(&obj_path).map_err(|e| {
+        let bytes = read_regular(&obj_path).map_err(|e| {
             SceneError::new(
                 &obj_path,
                 format!(
@@ -429,24 +438,41 @@ impl<'a> Builder<'a> {
         // tobj asks for MTL files by the name in `mtllib`; read them ourselves so a missing or
         // broken one is reported with its path.
         let obj_dir = obj_path.parent().map(Path::to_path_buf).unwrap_or_default();
+        // Every problem below names the file at fault and, after it, the scene that uses it.
+        let of = format!("mesh {index} of {}", self.scene_path.display());
         let mtl_error: RefCell<Option<SceneError>> = RefCell::new(None);
         let mtl_bytes: RefCell<Vec<u8>> = RefCell::new(Vec::new());
+        let mtl_files: RefCell<Vec<String>> = RefCell::new(Vec::new());
         let loaded = tobj::load_obj_buf(
             &mut BufReader::new(&bytes[..]),
+            // Faces come whole and are triangulated here (`polygon`): tobj's fan is wrong for
+            // non-convex faces and makes a hopeless BVH of a huge one.
             &tobj::LoadOptions {
-                triangulate: true,
+                triangulate: false,
                 single_index: true,
-                ..Default::default()
+                ignore_points: true,
+                ignore_lines: true,
             },
             |p| {
                 let mtl_path = obj_dir.join(p);
-                match std::fs::read(&mtl_path) {
+                match read_regular(&mtl_path) {
                     Ok(b) => {
                         mtl_bytes.borrow_mut().extend_from_slice(&b);
+                        mtl_files.borrow_mut().push(p.display().to_string());
+                        let b = match grey_colours(&b) {
+                            Ok(b) => b,
+                            Err(problem) => {
+                                *mtl_error.borrow_mut() = Some(SceneError::new(
+                                    &mtl_path,
+                                    format!("malformed MTL file: {problem} ({of})"),
+                                ));
+                                return Err(tobj::LoadError::MaterialParseError);
+                            }
+                        };
                         tobj::load_mtl_buf(&mut BufReader::new(&b[..])).inspect_err(|e| {
                             *mtl_error.borrow_mut() = Some(SceneError::new(
                                 &mtl_path,
-                                format!("malformed MTL file: {e}"),
+                                format!("malformed MTL file: {e} ({of})"),
                             ));
                         })
                     }
@@ -454,7 +480,7 @@ impl<'a> Builder<'a> {
                         *mtl_error.borrow_mut() = Some(SceneError::new(
                             &mtl_path,
                             format!(
-                                "cannot read MTL file named by `mtllib` in {}: {e}",
+                                "cannot read MTL file named by `mtllib` in {}: {e} ({of})",
                                 obj_path.display()
                             ),
                         ));
@@ -467,11 +493,10 @@ impl<'a> Builder<'a> {
             return Err(e);
         }
         self.hash.write(&mtl_bytes.into_inner());
-        let (models, materials) =
-            loaded.map_err(|e| SceneError::new(&obj_path, format!("malformed OBJ file: {e}")))?;
-        let materials = materials.map_err(|e| {
-            SceneError::new(&obj_path, format!("its materials failed to load: {e}"))
-        })?;
+        let oerr = |problem: String| SceneError::new(&obj_path, format!("{problem} ({of})"));
+        let (models, materials) = loaded.map_err(|e| oerr(format!("malformed OBJ file: {e}")))?;
+        let materials =
+            materials.map_err(|e| oerr(format!("its materials failed to load: {e}")))?;
 
         // MTL materials → ids (scene-file materials of the same name win).
         let mut mat_ids = Vec::with_capacity(materials.len());
@@ -479,16 +504,52 @@ impl<'a> Builder<'a> {
             let id = match self.by_name.get(&m.name) {
                 Some(&id) => id,
                 None => {
-                    let (mat, e) = convert_mtl(m, desc.emission).map_err(|p| {
-                        SceneError::new(&obj_path, format!("material `{}`: {p}", m.name))
-                    })?;
+                    let (mat, e) = convert_mtl(m, desc.emission)
+                        .map_err(|p| oerr(format!("material `{}`: {p}", m.name)))?;
                     self.add_material(&m.name, mat, e)
                 }
             };
             mat_ids.push(id);
         }
-        self.validate_materials()
-            .map_err(|e| SceneError::new(&obj_path, e.problem))?;
+        self.validate_materials().map_err(|e| oerr(e.problem))?;
+
+        // Each way a face can lack a material has its own message: tobj reports all of them
+        // as a model without a material id.
+        let directives = obj_directives(&bytes);
+        for (line, name) in &directives.usemtl {
+            if materials.iter().any(|m| &m.name == name) {
+                continue;
+            }
+            let mtl_files = mtl_files.borrow();
+            return Err(oerr(if mtl_files.is_empty() {
+                format!(
+                    "`usemtl {name}` (line {line}) names a material, but the OBJ names no MTL \
+                     file (no `mtllib` line)"
+                )
+            } else {
+                format!(
+                    "`usemtl {name}` (line {line}): unknown material; {} define{} {}",
+                    mtl_files.join(", "),
+                    if mtl_files.len() == 1 { "s" } else { "" },
+                    if materials.is_empty() {
+                        "none".to_string()
+                    } else {
+                        materials
+                            .iter()
+                            .map(|m| format!("`{}`", m.name))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    }
+                )
+            }));
+        }
+        if models.iter().all(|m| m.mesh.indices.is_empty()) {
+            return Err(oerr(if directives.lines == 0 {
+                "the OBJ file is empty: no vertices, no faces".to_string()
+            } else {
+                "the OBJ file holds no faces (no `f` line)".to_string()
+            }));
+        }
 
         let xf = transform(desc).ok_or_else(|| {
             self.err(format!(
@@ -499,22 +560,32 @@ impl<'a> Builder<'a> {
         let nxf = DMat3::from_mat4(xf).inverse().transpose();
         for model in &models {
             let m = &model.mesh;
+            if m.indices.is_empty() {
+                continue;
+            }
             let nv = m.positions.len() / 3;
             let mut part = TriMesh::default();
             for (v, p) in m.positions.chunks_exact(3).enumerate() {
                 let p = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
                 if !p.is_finite() {
-                    return Err(SceneError::new(
-                        &obj_path,
-                        format!(
-                            "object `{}`: vertex {} is not finite ({:?})",
-                            model.name,
-                            v + 1,
-                            p.to_array()
-                        ),
-                    ));
+                    return Err(oerr(format!(
+                        "object `{}`: vertex {} is not finite ({:?})",
+                        model.name,
+                        v + 1,
+                        p.to_array()
+                    )));
                 }
-                part.positions.push(xf.transform_point3(p).as_vec3());
+                let q = xf.transform_point3(p);
+                if !q.is_finite() || q.abs().max_element() > MAX_COORD {
+                    return Err(oerr(format!(
+                        "object `{}`: vertex {} lies at {:?} after the mesh's transform, beyond \
+                         the {MAX_COORD:e} scene units photonflow can trace: check the scale",
+                        model.name,
+                        v + 1,
+                        q.to_array()
+                    )));
+                }
+                part.positions.push(q.as_vec3());
             }
             let use_file_normals =
                 matches!(desc.normals, NormalMode::Auto) && m.normals.len() == 3 * nv;
@@ -523,14 +594,11 @@ impl<'a> Builder<'a> {
                     let n = DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64);
                     let n = (nxf * n).normalize_or_zero();
                     if !n.is_finite() || n == DVec3::ZERO {
-                        return Err(SceneError::new(
-                            &obj_path,
-                            format!(
-                                "object `{}`: normal {} is zero or not finite",
-                                model.name,
-                                v + 1
-                            ),
-                        ));
+                        return Err(oerr(format!(
+                            "object `{}`: normal {} is zero or not finite",
+                            model.name,
+                            v + 1
+                        )));
                     }
                     part.normals.push(n.as_vec3());
                 }
@@ -538,31 +606,46 @@ impl<'a> Builder<'a> {
             let mat = match m.material_id {
                 Some(i) if i < mat_ids.len() => mat_ids[i],
                 Some(i) => {
-                    return Err(SceneError::new(
-                        &obj_path,
-                        format!(
-                            "object `{}` uses material index {i} that its MTL does not define",
-                            model.name
-                        ),
-                    ));
+                    return Err(oerr(format!(
+                        "object `{}` uses material index {i} that its MTL does not define",
+                        model.name
+                    )));
                 }
                 None => {
-                    return Err(SceneError::new(
-                        &obj_path,
-                        format!("object `{}` has no material (no `usemtl`)", model.name),
-                    ));
+                    return Err(oerr(format!(
+                        "object `{}` has faces before any `usemtl` line, so they have no material",
+                        model.name
+                    )));
                 }
             };
-            for t in m.indices.chunks_exact(3) {
-                if t.iter().any(|&i| i as usize >= nv) {
-                    return Err(SceneError::new(
-                        &obj_path,
-                        format!("object `{}`: face index out of range", model.name),
-                    ));
-                }
-                part.indices.push([t[0], t[1], t[2]]);
-                part.materials.push(mat);
+            if m.indices.iter().any(|&i| i as usize >= nv) {
+                return Err(oerr(format!(
+                    "object `{}`: face index out of range",
+                    model.name
+                )));
             }
+            // All triangles (no arities) or one arity per face.
+            let arities: Box<dyn Iterator<Item = usize>> = if m.face_arities.is_empty() {
+                Box::new(std::iter::repeat_n(3, m.indices.len() / 3))
+            } else {
+                Box::new(m.face_arities.iter().map(|&a| a as usize))
+            };
+            let mut start = 0usize;
+            let mut triangles = Vec::new();
+            for (f, n) in arities.enumerate() {
+                let Some(face) = m.indices.get(start..start.saturating_add(n)) else {
+                    return Err(oerr(format!(
+                        "object `{}`: face {} runs past the index list",
+                        model.name,
+                        f + 1
+                    )));
+                };
+                start += n;
+                crate::polygon::triangulate(face, &part.positions, &mut triangles)
+                    .map_err(|p| oerr(format!("object `{}`, face {}: {p}", model.name, f + 1)))?;
+            }
+            part.materials = vec![mat; triangles.len()];
+            part.indices = triangles;
             if desc.normals == NormalMode::Smooth {
                 part.normals = smooth_vertex_normals(&part.positions, &part.indices);
             }
@@ -570,6 +653,97 @@ impl<'a> Builder<'a> {
         }
         Ok(())
     }
+}
+
+/// Largest coordinate (scene units, after a mesh's transform) of any vertex or sphere. The
+/// BVH builder and the intersection code work in f32: surface areas of boxes and edge cross
+/// products multiply two coordinate differences (up to (2x)^2, times 6 summed over a box's
+/// faces), which overflows f32's 3.4e38 near |x| = 3.7e18, and obvhs panics on the infinite
+/// areas. 1e15 keeps three orders of magnitude below that and still admits any real scene
+/// in metres or millimetres.
+pub const MAX_COORD: f64 = 1e15;
+
+/// Reads a file a scene names, refusing anything but a regular file before opening it:
+/// opening a FIFO blocks until a writer comes, and a device may never end.
+fn read_regular(path: &Path) -> std::io::Result<Vec<u8>> {
+    let meta = std::fs::metadata(path)?;
+    if !meta.is_file() {
+        let t = meta.file_type();
+        let what = if t.is_dir() {
+            "a directory"
+        } else if t.is_symlink() {
+            "a symbolic link"
+        } else {
+            "a FIFO, socket or device"
+        };
+        return Err(std::io::Error::other(format!(
+            "it is {what}, not a regular file"
+        )));
+    }
+    std::fs::read(path)
+}
+
+/// An OBJ file's `usemtl` lines (1-based line number, material name, first use of each name)
+/// and its number of non-blank, non-comment lines, read as tobj reads them.
+struct ObjDirectives {
+    usemtl: Vec<(usize, String)>,
+    lines: usize,
+}
+
+fn obj_directives(bytes: &[u8]) -> ObjDirectives {
+    let mut d = ObjDirectives {
+        usemtl: Vec::new(),
+        lines: 0,
+    };
+    for (i, line) in String::from_utf8_lossy(bytes).lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        d.lines += 1;
+        if line.split_whitespace().next() == Some("usemtl") {
+            let name = line.split_once(' ').unwrap_or_default().1.trim();
+            if !name.is_empty() && !d.usemtl.iter().any(|(_, n)| n == name) {
+                d.usemtl.push((i + 1, name.to_string()));
+            }
+        }
+    }
+    d
+}
+
+/// MTL colours (`Ka`, `Kd`, `Ks`, `Ke`, `Tf`) given with one number are grey, a variant real
+/// MTL files use: written out as three numbers here, since tobj panics on fewer than three.
+/// Two numbers or none is an error naming the line.
+fn grey_colours(bytes: &[u8]) -> Result<Vec<u8>, String> {
+    let Ok(text) = std::str::from_utf8(bytes) else {
+        return Err("not UTF-8 text".into());
+    };
+    let mut out = String::with_capacity(text.len() + 64);
+    for (i, line) in text.split_inclusive('\n').enumerate() {
+        let mut words = line.split_whitespace();
+        let key = words.next();
+        if let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke" | "Tf")) = key {
+            let args: Vec<&str> = words.collect();
+            let numbers = args.iter().take_while(|w| w.parse::<f32>().is_ok()).count();
+            match (args.len(), numbers) {
+                (1, 1) => {
+                    let v = args[0];
+                    out.push_str(&format!("{key} {v} {v} {v}\n"));
+                    continue;
+                }
+                (0, _) | (2, 2) => {
+                    return Err(format!(
+                        "line {}: `{key}` needs one number (grey) or three (RGB), got {}",
+                        i + 1,
+                        args.len()
+                    ));
+                }
+                _ => {}
+            }
+        }
+        out.push_str(line);
+    }
+    Ok(out.into_bytes())
 }
 
 fn in_unit(v: Vec3) -> bool {

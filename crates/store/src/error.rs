@@ -21,6 +21,9 @@ pub enum Problem {
         error: std::io::Error,
     },
     NotPhotonFile,
+    /// A directory, FIFO, socket or device where a photon file should be (never opened: a
+    /// FIFO would block).
+    NotRegularFile(&'static str),
     Version {
         found: u32,
     },
@@ -68,6 +71,7 @@ impl fmt::Display for Problem {
         match self {
             Problem::Io { op, error } => write!(f, "cannot {op}: {error}"),
             Problem::NotPhotonFile => write!(f, "not a photon file (bad magic)"),
+            Problem::NotRegularFile(what) => write!(f, "not a regular file (it is {what})"),
             Problem::Version { found } => write!(
                 f,
                 "format version {found}, this build reads {FORMAT_VERSION}"

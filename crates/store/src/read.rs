@@ -44,9 +44,24 @@ pub struct StoreReader {
     head: [u8; CHUNK_HEADER_LEN],
 }
 
+/// Opens a photon file, refusing anything but a regular file first: opening a FIFO blocks
+/// until a writer comes, and a device may never end.
+fn open_regular(path: &Path) -> Result<File, StoreError> {
+    let meta = std::fs::metadata(path).map_err(|e| StoreError::io(path, "open", e))?;
+    if !meta.is_file() {
+        let what = if meta.is_dir() {
+            "a directory"
+        } else {
+            "a FIFO, socket or device"
+        };
+        return Err(StoreError::new(path, Problem::NotRegularFile(what)));
+    }
+    File::open(path).map_err(|e| StoreError::io(path, "open", e))
+}
+
 impl StoreReader {
     pub fn open(path: &Path) -> Result<StoreReader, StoreError> {
-        let mut file = File::open(path).map_err(|e| StoreError::io(path, "open", e))?;
+        let mut file = open_regular(path)?;
         let (header, chunks) = read_header(path, &mut file)?;
         Ok(StoreReader {
             path: path.to_path_buf(),
@@ -133,7 +148,7 @@ pub struct MappedStore {
 
 impl MappedStore {
     pub fn open(path: &Path) -> Result<MappedStore, StoreError> {
-        let file = File::open(path).map_err(|e| StoreError::io(path, "open", e))?;
+        let file = open_regular(path)?;
         let len = file
             .metadata()
             .map_err(|e| StoreError::io(path, "stat", e))?

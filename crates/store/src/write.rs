@@ -16,7 +16,9 @@ use crate::format::{
 /// The file is written as `<path>.tmp-<pid>-<n>` with a zeroed magic; [`StoreWriter::finish`]
 /// writes the real header, fsyncs and renames it to `path`. So `path` either holds a complete,
 /// checksummed file or is untouched, whatever happens to this process; dropping an unfinished
-/// writer deletes its temp file.
+/// writer deletes its temp file, [`crate::remove_live_temp_files`] (a Ctrl-C handler) deletes
+/// every one of this process, and [`crate::remove_stale_temp_files`] those of a dead process
+/// (the pid in the name tells which).
 pub struct StoreWriter {
     path: PathBuf,
     tmp: PathBuf,
@@ -64,6 +66,7 @@ impl StoreWriter {
             .create_new(true)
             .open(&tmp)
             .map_err(|e| StoreError::io(&tmp, "create", e))?;
+        crate::temp::register(&tmp);
         let mut writer = StoreWriter {
             path: path.to_path_buf(),
             tmp,
@@ -169,6 +172,7 @@ impl StoreWriter {
         done?;
         fs::rename(&self.tmp, &self.path).map_err(|e| StoreError::io(&self.path, "rename", e))?;
         self.finished = true;
+        crate::temp::unregister(&self.tmp);
         // Best effort: makes the rename itself durable; some file systems refuse to sync a
         // directory, and the file is already complete either way.
         if let Some(dir) = self.path.parent() {
@@ -190,6 +194,7 @@ impl Drop for StoreWriter {
         if !self.finished {
             drop(self.file.take());
             let _ = fs::remove_file(&self.tmp);
+            crate::temp::unregister(&self.tmp);
         }
     }
 }

@@ -212,10 +212,28 @@ pub(crate) fn photon_inputs<'a>(
     // These methods read the global map as the full light arriving at a surface, direct hits
     // included; final gathering also needs the caustic map wherever the scene can make
     // caustics. A missing set would silently darken a layer, so it is an error.
+    let mut params_per_kind = store::PerKind::default();
+    params_per_kind[MapKind::Global] = s.estimate.global;
+    params_per_kind[MapKind::Caustic] = s.estimate.caustic;
+    // A scene with no diffuse surface (all black, or only mirrors and glass) is valid: no
+    // photon can be stored or seen, every photon layer is black, and the plan says why.
+    if params.global && !plan.global {
+        print!("{plan}");
+        return Ok(PhotonInputs {
+            plan,
+            maps: Maps {
+                maps: store::PerKind::default(),
+                params: params_per_kind,
+                boundary: None,
+                gather_cache: None,
+            },
+            seconds_trace: 0.0,
+            reused: true,
+            seconds_load: 0.0,
+        });
+    }
     let incomplete = if !plan.global {
-        Some(
-            "the effects plan traces no global photons (no diffuse surface, or [photons] global = false)",
-        )
+        Some("[photons] global = false: the effects plan traces no global photons")
     } else if !params.store_direct {
         Some(
             "[photons] store_direct = false leaves direct light out of the global map these methods read",
@@ -243,9 +261,6 @@ pub(crate) fn photon_inputs<'a>(
         vec![MapKind::Global]
     };
     let maps = photon_cache::load_maps(run.cache, &key, &kinds)?;
-    let mut params_per_kind = store::PerKind::default();
-    params_per_kind[MapKind::Global] = s.estimate.global;
-    params_per_kind[MapKind::Caustic] = s.estimate.caustic;
     Ok(PhotonInputs {
         plan,
         maps: Maps {

@@ -109,11 +109,10 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     params.store_direct = !sp.direct;
     let plan =
         Plan::for_scene(scene, &params).map_err(|e| format!("{}: {e}", scene.path.display()))?;
+    // No diffuse surface (all black, or only mirrors and glass): a valid scene whose photon
+    // layer is black; the passes still average what the eye sees of the emitters.
     if !plan.global {
-        return Err(format!(
-            "{}: sppm needs diffuse surfaces to gather photons on",
-            scene.path.display()
-        ));
+        print!("{plan}");
     }
     let est = s.estimate.global;
     let r0 = if sp.radius > 0.0 {
@@ -139,7 +138,11 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     while passes < sp.passes {
         let pass = passes as u64;
         let points = eye::visible_points(scene, pass, sp.direct, run.threads);
-        let photons = pass_photons(scene, &params, &plan, pass, run.threads())?;
+        let photons = if plan.global {
+            pass_photons(scene, &params, &plan, pass, run.threads())?
+        } else {
+            Vec::new()
+        };
         photons_stored += photons.len() as u64;
         let map = PhotonMap::build(photons, IndexKind::KdTree);
         // Each pixel's update reads only its own statistics: the same for any thread count.

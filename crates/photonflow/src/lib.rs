@@ -1,0 +1,580 @@
+//! `photonflow`: the one renderer binary. Each subcommand is a stage or a tool; `cargo xtask`
+//! chains them. Errors print one line naming the file and the problem and exit non-zero;
+//! nothing here panics on bad input.
+//!
+//! The command line lives in this library ([`run_args`]) so the end-to-end tests run every
+//! command exactly as the binary does, in process; `main.rs` adds only what a process owns
+//! (the Ctrl-C handler, printing the error, the exit code).
+
+mod composite;
+
+use clap::{Parser, Subcommand};
+use pipeline::{Overrides, Photons, RenderRequest};
+use scene::{Method, Scene};
+use std::path::{Path, PathBuf};
+
+#[derive(Parser)]
+#[command(name = "photonflow", about = "Photon-mapping renderer", version)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Load a scene and print what it holds.
+    Info { scene: PathBuf },
+    /// Single-thread ray casting throughput (closest hit), coherent and incoherent.
+    BenchRays {
+        scene: PathBuf,
+        /// Timed runs per kind; the median is reported.
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        /// Rays per run.
+        #[arg(long, default_value_t = 1 << 20)]
+        rays: usize,
+        /// Also measure the binary BVH (Bvh2) next to the default CwBvh.
+        #[arg(long)]
+        compare: bool,
+    },
+    /// Photon paths/s on 1 and 2 threads, tracing only and through the pipeline to files.
+    BenchPhotons {
+        scene: PathBuf,
+        #[arg(long, default_value_t = 1_000_000)]
+        photons: u64,
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+    },
+    /// Write/read throughput of a photon file (default 10M photons), and encodings compared.
+    BenchStore {
+        #[arg(long, default_value_t = 10_000_000)]
+        photons: usize,
+        /// Directory for the temporary file.
+        #[arg(long, default_value = "out/bench")]
+        dir: PathBuf,
+    },
+    /// Caustic photons traced with differentials and splatted onto eye vertices: photons/s on
+    /// 1 and 2 threads, eye vertices, peak memory.
+    BenchSplat {
+        scene: PathBuf,
+        #[arg(long, default_value_t = 1_000_000)]
+        photons: u64,
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+    },
+    /// Time each method needs to reach the error of a 256-spp path-traced image, against a
+    /// long path-traced reference (rendered once and cached, or given), in one run.
+    BenchAccuracy {
+        scene: PathBuf,
+        /// A linear RGB EXR of the same view from any renderer (else a path-traced one is
+        /// rendered once into --dir and reused).
+        #[arg(long)]
+        reference: Option<PathBuf>,
+        /// Samples per pixel of the rendered reference.
+        #[arg(long, default_value_t = 4096)]
+        reference_spp: u32,
+        /// Another renderer timed in the same run: NAME=COMMAND, a shell command that writes
+        /// a linear EXR of the same view to the path in $OUT. Repeatable.
+        #[arg(long, value_parser = parse_peer)]
+        peer: Vec<(String, String)>,
+        /// Where runs, snapshots and the cached reference go.
+        #[arg(long, default_value = "out/bench/accuracy")]
+        dir: PathBuf,
+    },
+    /// k-NN queries/s for k = 50, 250, 1000 for each index.
+    BenchKnn {
+        #[arg(long, default_value_t = 1_000_000)]
+        photons: usize,
+        #[arg(long, default_value_t = 20_000)]
+        queries: usize,
+    },
+    /// Render an image. `--method path` is the path-traced reference; `global-direct` and
+    /// `final-gather` chain trace (or reuse the cached photons) → estimate → composite.
+    Render {
+        scene: PathBuf,
+        /// path, global-direct, final-gather, caustic-splat, path+splat or sppm (default: the
+        /// scene's render.method, whose default is sppm).
+        #[arg(long)]
+        method: Option<Method>,
+        #[command(flatten)]
+        photon: PhotonArgs,
+        #[command(flatten)]
+        image: ImageArgs,
+        /// Path tracer: leave out exactly the paths photon splatting owns (L S+ D S* E, D the
+        /// first diffuse vertex from the eye), so a splatted caustic layer can be added.
+        #[arg(long)]
+        no_caustics: bool,
+    },
+    /// Estimate an image from cached photon sets (never traces).
+    Estimate {
+        scene: PathBuf,
+        /// global-direct (the global map shown directly) or final-gather (default: the
+        /// scene's render.method when it is one of these, else global-direct).
+        #[arg(long)]
+        method: Option<Method>,
+        #[command(flatten)]
+        photon: PhotonArgs,
+        #[command(flatten)]
+        image: ImageArgs,
+    },
+    /// Worksheet 7's deliverable: the global map shown directly with the box kernel, with
+    /// Silverman's kernel, and with the topological test; errors against a path-traced
+    /// reference; a Markdown summary beside the images.
+    Worksheet {
+        #[arg(long, default_value = "scenes/cornell-spheres/analytic.toml")]
+        scene: PathBuf,
+        /// Photon paths (each stores about 2.3 global photons in the Cornell box).
+        #[arg(long, default_value_t = 200_000)]
+        photons: u64,
+        #[arg(long, default_value_t = 1000)]
+        k: usize,
+        /// Topological test tolerance.
+        #[arg(long, default_value_t = 0.1)]
+        topo: f32,
+        #[arg(long, default_value_t = 1024)]
+        reference_spp: u32,
+        #[arg(long, default_value = "out/worksheet")]
+        out: PathBuf,
+        #[arg(long, default_value = "out/cache")]
+        cache: PathBuf,
+        #[arg(long, value_parser = parse_threads)]
+        threads: Option<usize>,
+    },
+    /// What accuracy costs in time, bias and variance apart: each technique over a ladder of
+    /// budgets, `--seeds` independent runs each, against a reference; errors and bias^2 /
+    /// variance per region (from the scene's geometry), maps as EXR and false-colour PNG.
+    Evidence {
+        #[arg(default_value = "scenes/cornell-spheres/analytic.toml")]
+        scene: PathBuf,
+        /// A linear RGB EXR of the same view from any renderer (else a path-traced one,
+        /// rendered once into --out and reused).
+        #[arg(long)]
+        reference: Option<PathBuf>,
+        #[arg(long, default_value_t = 1024)]
+        reference_spp: u32,
+        /// Independent runs (seeds 1..=N) per technique and budget.
+        #[arg(long, default_value_t = 8)]
+        seeds: u32,
+        /// The short ladder: a few minutes on 2 cores.
+        #[arg(long)]
+        quick: bool,
+        /// Multiply every budget of the ladder and the k sweep's photon counts by this.
+        #[arg(long, default_value_t = 1.0)]
+        budget_scale: f64,
+        #[arg(long, default_value = "out/evidence")]
+        out: PathBuf,
+        #[arg(long, value_parser = parse_threads)]
+        threads: Option<usize>,
+    },
+    /// Trace the photon sets a scene needs into the cache (or reuse them).
+    Trace {
+        scene: PathBuf,
+        /// Seed of every random stream (default: the scene file's `seed`).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Photon paths to emit (default: the scene's [photons] table).
+        #[arg(long)]
+        photons: Option<u64>,
+        /// Cache directory of photon files.
+        #[arg(long, default_value = "out/cache")]
+        cache: PathBuf,
+        #[arg(long, value_parser = parse_threads)]
+        threads: Option<usize>,
+        /// Trace even if the cache holds the sets.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Combine runs of one view (their output directories or `image.exr` paths): layers of
+    /// one name averaged by their counts, disjoint layers summed, in f64, in a fixed order.
+    Composite {
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+        #[arg(long)]
+        out: PathBuf,
+        /// Exposure of the PNG in stops.
+        #[arg(long, default_value_t = 0.0, value_parser = parse_finite)]
+        exposure: f32,
+    },
+    /// Error metrics of image A against reference B (linear EXR files).
+    Compare {
+        a: PathBuf,
+        b: PathBuf,
+        /// Restrict to the pixel rectangle x0,y0,x1,y1 (half open).
+        #[arg(long, value_parser = parse_rect)]
+        mask: Option<[usize; 4]>,
+    },
+}
+
+/// `NAME=COMMAND` of `--peer`.
+fn parse_peer(s: &str) -> Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((name, cmd)) if !name.is_empty() && !cmd.is_empty() => {
+            Ok((name.to_string(), cmd.to_string()))
+        }
+        _ => Err(format!("`{s}`: expected NAME=COMMAND")),
+    }
+}
+
+/// Image settings shared by `render` and `estimate`.
+#[derive(clap::Args)]
+struct ImageArgs {
+    /// Samples per pixel (default: the scene file's render.spp for `path`, estimate.spp
+    /// (default 1) for the photon methods, which already average many photons per estimate).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long, value_parser = parse_threads)]
+    threads: Option<usize>,
+    /// Output directory (default: out/<scene dir>-<scene stem>-<method>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Exposure of the PNG in stops.
+    #[arg(long, default_value_t = 0.0, value_parser = parse_finite)]
+    exposure: f32,
+}
+
+/// Photon-mapping settings shared by `estimate` and `render`.
+#[derive(clap::Args)]
+struct PhotonArgs {
+    /// Seed of every random stream (default: the scene file's `seed`); recorded in the
+    /// outputs' `scene.toml` and `image.json`.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Photon paths emitted (default: the scene's [photons] table).
+    #[arg(long)]
+    photons: Option<u64>,
+    /// Directory of cached photon files.
+    #[arg(long, default_value = "out/cache")]
+    cache: PathBuf,
+    /// Nearest photons per global-map estimate (default: [estimate.global] k, else 1000).
+    #[arg(long)]
+    k: Option<usize>,
+    /// Kernel of the global-map estimate: uniform, silverman, epanechnikov, triweight,
+    /// gaussian, gaussian-jensen, cone, cone:K.
+    #[arg(long, value_parser = pipeline::settings::parse_kernel)]
+    kernel: Option<density::Kernel>,
+    /// Topological test: keep photons whose direction from the estimation point is within
+    /// |cos| < EPS of the tangent plane.
+    #[arg(long)]
+    topo: Option<f32>,
+    /// Drop the k-th photon (Garcia et al. 2012).
+    #[arg(long)]
+    drop_kth: bool,
+    /// Correct global-map estimates for boundary bias: divide by the share of the kernel's
+    /// mass that lies on the surface (found by short probe rays).
+    #[arg(long)]
+    boundary: bool,
+    /// Final-gather rays per sample (default: the scene's estimate.final_gather.rays, 16).
+    #[arg(long)]
+    gather_rays: Option<u32>,
+    /// Final gathering reads irradiance precomputed at every N-th global photon
+    /// (Christensen 1999); 0 estimates from the map at every gather hit (default: the
+    /// scene's estimate.final_gather.cache, 4).
+    #[arg(long)]
+    gather_cache: Option<usize>,
+    /// Photon passes of the progressive methods (caustic-splat, path+splat; default: the
+    /// scene's estimate.splat.passes, 1).
+    #[arg(long)]
+    passes: Option<u32>,
+    /// Stop the progressive methods' passes after this many seconds (at least one pass runs);
+    /// the output's scene.toml records the passes made.
+    #[arg(long)]
+    time: Option<f64>,
+    /// Compare with this linear EXR (the path-traced reference) and record the error.
+    #[arg(long)]
+    reference: Option<PathBuf>,
+    /// Name of the output directory's method part.
+    #[arg(long)]
+    label: Option<String>,
+}
+
+impl PhotonArgs {
+    fn overrides(&self, method: Option<Method>, spp: Option<u32>) -> Overrides {
+        Overrides {
+            method,
+            spp,
+            photons: self.photons,
+            k: self.k,
+            kernel: self.kernel,
+            topo: self.topo.map(Some),
+            drop_kth: self.drop_kth.then_some(true),
+            boundary: self.boundary.then_some(true),
+            gather_rays: self.gather_rays,
+            gather_cache: self.gather_cache,
+            caustics: None,
+            passes: self.passes,
+            splat_photons: None,
+            splat_indirect: None,
+            time: self.time,
+        }
+    }
+}
+
+/// The one load of a command's scene, with `--seed` applied.
+fn load(path: &Path, seed: Option<u64>) -> Result<Scene, String> {
+    Scene::load_with(path, |f| {
+        if let Some(s) = seed {
+            f.seed = s;
+        }
+    })
+    .map_err(|e| e.to_string())
+}
+
+/// `render` and `estimate`: the one path through the library, then a summary line.
+fn render(scene: &Scene, req: RenderRequest) -> Result<(), String> {
+    let r = pipeline::render(scene, &req)?;
+    println!(
+        "rendered {} in {:.2} s; wrote {}/image.{{exr,png,json}}, layers/, scene.toml",
+        r.settings.method,
+        r.seconds,
+        r.out.display()
+    );
+    if let Some(m) = &r.metrics {
+        println!("against the reference: {m}");
+    }
+    Ok(())
+}
+
+/// `--threads`: 0 would leave no worker, whatever the command does first (a cache hit too).
+fn parse_threads(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(0) => Err("must be at least 1".into()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// A number that must be finite (`--exposure`): NaN or infinity would make every pixel NaN.
+fn parse_finite(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(x) if x.is_finite() => Ok(x),
+        Ok(x) => Err(format!("{x} is not a finite number")),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+fn parse_rect(s: &str) -> Result<[usize; 4], String> {
+    let v: Vec<usize> = s
+        .split(',')
+        .map(|t| t.trim().parse::<usize>().map_err(|e| format!("`{t}`: {e}")))
+        .collect::<Result<_, _>>()?;
+    <[usize; 4]>::try_from(v).map_err(|_| "expected x0,y0,x1,y1".to_string())
+}
+
+/// Runs the command line `args` (the program name first) as the binary does. Returns the exit
+/// code and, for a failure, the one line the binary prints on stderr (not printed here):
+/// 2 for a usage error, 1 for a command that fails. Help and version go to stdout (exit 0).
+pub fn run_args<I, T>(args: I) -> (u8, Option<String>)
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let cli = match Cli::try_parse_from(args) {
+        Ok(c) => c,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            let code = e.exit_code() as u8;
+            // clap's own usage errors span several lines; here they are one.
+            return match e.kind() {
+                ErrorKind::DisplayHelp
+                | ErrorKind::DisplayVersion
+                | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                    let _ = e.print();
+                    (code, None)
+                }
+                _ => {
+                    let text = e.to_string();
+                    let line: Vec<&str> = text
+                        .lines()
+                        .map(str::trim)
+                        .take_while(|l| {
+                            !l.starts_with("Usage:") && !l.starts_with("For more information")
+                        })
+                        .filter(|l| !l.is_empty())
+                        .collect();
+                    (code, Some(format!("{} (see --help)", line.join(" "))))
+                }
+            };
+        }
+    };
+    match run(cli.cmd) {
+        Ok(()) => (0, None),
+        Err(e) => {
+            // One line, whatever a library's message holds (a TOML error's excerpt, say).
+            let line: Vec<&str> = e.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+            (1, Some(format!("error: {}", line.join("; "))))
+        }
+    }
+}
+
+fn run(cmd: Cmd) -> Result<(), String> {
+    match cmd {
+        Cmd::Info { scene } => info(&scene),
+        Cmd::BenchRays {
+            scene,
+            runs,
+            rays,
+            compare,
+        } => pipeline::bench::rays(&scene, runs, rays, compare),
+        Cmd::Render {
+            scene,
+            method,
+            photon,
+            image,
+            no_caustics,
+        } => {
+            let s = load(&scene, photon.seed)?;
+            let overrides = Overrides {
+                caustics: no_caustics.then_some(false),
+                ..photon.overrides(method, image.spp)
+            };
+            render(
+                &s,
+                RenderRequest {
+                    overrides,
+                    cache: &photon.cache,
+                    photons: Photons::TraceOrReuse,
+                    threads: image.threads,
+                    out: image.out,
+                    exposure: image.exposure,
+                    reference: photon.reference.as_deref(),
+                    label: photon.label.clone(),
+                },
+            )
+        }
+        Cmd::Estimate {
+            scene,
+            method,
+            photon,
+            image,
+        } => {
+            let reads_maps = |m: Method| pipeline::methods::spec(m).photon_maps;
+            if let Some(m) = method
+                && !reads_maps(m)
+            {
+                return Err(format!(
+                    "estimate reads photon maps: use `render --method {m}` for `{m}`"
+                ));
+            }
+            let s = load(&scene, photon.seed)?;
+            // A scene whose default reads no photon maps still gets a photon method here.
+            let method = method.unwrap_or(match s.render().method {
+                m if reads_maps(m) => m,
+                _ => Method::GlobalDirect,
+            });
+            render(
+                &s,
+                RenderRequest {
+                    overrides: photon.overrides(Some(method), image.spp),
+                    cache: &photon.cache,
+                    photons: Photons::CacheOnly,
+                    threads: image.threads,
+                    out: image.out,
+                    exposure: image.exposure,
+                    reference: photon.reference.as_deref(),
+                    label: photon.label.clone(),
+                },
+            )
+        }
+        Cmd::Composite {
+            inputs,
+            out,
+            exposure,
+        } => composite::run(&inputs, &out, exposure),
+        Cmd::Compare { a, b, mask } => {
+            let m = pipeline::output::compare(&a, &b, mask)?;
+            let flip = pipeline::output::compare_flip(&a, &b, mask)?;
+            println!("{m} flip={flip:.5}");
+            Ok(())
+        }
+        Cmd::BenchPhotons {
+            scene,
+            photons,
+            runs,
+        } => pipeline::bench::photons(&scene, photons, runs),
+        Cmd::BenchStore { photons, dir } => pipeline::bench::store(photons, &dir),
+        Cmd::BenchSplat {
+            scene,
+            photons,
+            runs,
+        } => pipeline::bench::splat(&scene, photons, runs),
+        Cmd::BenchKnn { photons, queries } => pipeline::bench::knn(photons, queries),
+        Cmd::BenchAccuracy {
+            scene,
+            reference,
+            reference_spp,
+            peer,
+            dir,
+        } => {
+            let peers: Vec<pipeline::accuracy::Peer> = peer
+                .into_iter()
+                .map(|(name, command)| pipeline::accuracy::Peer { name, command })
+                .collect();
+            pipeline::accuracy::accuracy(&scene, reference.as_deref(), reference_spp, &peers, &dir)
+        }
+        Cmd::Evidence {
+            scene,
+            reference,
+            reference_spp,
+            seeds,
+            quick,
+            budget_scale,
+            out,
+            threads,
+        } => pipeline::evidence::run(&pipeline::evidence::EvidenceArgs {
+            scene,
+            reference,
+            reference_spp,
+            seeds,
+            quick,
+            budget_scale,
+            out,
+            threads,
+        }),
+        Cmd::Worksheet {
+            scene,
+            photons,
+            k,
+            topo,
+            reference_spp,
+            out,
+            cache,
+            threads,
+        } => {
+            let s = load(&scene, None)?;
+            pipeline::worksheet::run(
+                &s,
+                &pipeline::worksheet::WorksheetArgs {
+                    scene,
+                    photons,
+                    k,
+                    topo,
+                    reference_spp,
+                    out,
+                    cache,
+                    threads,
+                },
+            )
+        }
+        Cmd::Trace {
+            scene,
+            seed,
+            photons,
+            cache,
+            threads,
+            force,
+        } => {
+            let s = load(&scene, seed)?;
+            let overrides = Overrides {
+                photons,
+                ..Overrides::default()
+            };
+            pipeline::trace(&s, &overrides, &cache, threads, force).map(|_| ())
+        }
+    }
+}
+
+fn info(path: &Path) -> Result<(), String> {
+    print!("{}", pipeline::describe(&load(path, None)?));
+    Ok(())
+}

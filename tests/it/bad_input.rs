@@ -1,0 +1,929 @@
+//! Bad input, one table: each case writes its input files into a scratch directory, runs one
+//! command line through `photonflow::run_args` (the binary's own entry, in process), and
+//! checks the exit code and that the error is one line holding the given words (the file at
+//! fault and the problem). Cases that must succeed (valid scenes once refused, `Kd 0.5`) check
+//! what they wrote instead. A case that hangs fails after a timeout; one that panics fails
+//! with the panic.
+//!
+//! Each kind of issue 12's point 1 has cases here: panics, hangs, accepted bad values,
+//! partial output, messages, valid scenes refused and temporary files (a stale file from a
+//! dead process; Ctrl-C itself needs a process: the binary's own test `cli.rs` signals it).
+//! Every loader (OBJ, MTL, scene file, photon file, EXR) and every command's flags have cases
+//! too (the bench commands only with values refused before any timing starts).
+
+use film::Image;
+use std::path::Path;
+use std::sync::mpsc;
+use std::time::Duration;
+use tests::TempDir;
+
+const CAMERA: &str =
+    "[camera]\neye = [0, 1, 3]\nlook_at = [0, 0, 0]\nvfov = 60\nwidth = 16\nheight = 16\n";
+const OBJ: &str = "mtllib m.mtl\no floor\nusemtl white\nv -1 0 -1\nv -1 0 1\nv 1 0 1\nv 1 0 -1\n\
+f 1 2 3\nf 1 3 4\no light\nusemtl light\nv -0.1 1 -0.1\nv 0.1 1 -0.1\nv 0.1 1 0.1\n\
+v -0.1 1 0.1\nf 5 6 7\nf 5 7 8\n";
+const MTL: &str = "newmtl white\nKd 0.5 0.5 0.5\nnewmtl light\nKd 0 0 0\nKe 4 4 4\n";
+
+/// One input file of a case.
+enum Input {
+    Text(String),
+    Exr(Image),
+    Fifo,
+}
+
+/// What a case must leave behind (paths relative to its directory).
+type Check = Box<dyn Fn(&Path)>;
+
+struct Case {
+    name: &'static str,
+    files: Vec<(&'static str, Input)>,
+    /// Commands run first, each of which must succeed (`{d}` is the case's directory).
+    setup: Vec<&'static str>,
+    /// Run after the setup commands: damages what they wrote (a cached photon file, say).
+    prepare: Option<fn(&Path)>,
+    /// The command line (`{d}` is the case's directory), split on spaces.
+    args: &'static str,
+    code: u8,
+    /// Words the one-line message must hold (empty for a success).
+    words: &'static [&'static str],
+    check: Option<Check>,
+}
+
+fn text(s: impl Into<String>) -> Input {
+    Input::Text(s.into())
+}
+
+fn scene(extra: &str) -> String {
+    format!("{CAMERA}[[mesh]]\nobj = \"a.obj\"\n{extra}")
+}
+
+/// The good scene's three files, with `obj` and `mtl` replacing the OBJ and MTL texts.
+fn files(toml: String, obj: &str, mtl: &str) -> Vec<(&'static str, Input)> {
+    vec![
+        ("s.toml", text(toml)),
+        ("a.obj", text(obj)),
+        ("m.mtl", text(mtl)),
+    ]
+}
+
+fn good() -> Vec<(&'static str, Input)> {
+    files(scene(""), OBJ, MTL)
+}
+
+fn with(
+    mut f: Vec<(&'static str, Input)>,
+    name: &'static str,
+    i: Input,
+) -> Vec<(&'static str, Input)> {
+    f.retain(|(n, _)| *n != name);
+    f.push((name, i));
+    f
+}
+
+fn grey(w: usize, h: usize) -> Image {
+    Image::from_fn(w, h, |_, _| [0.5; 3])
+}
+
+/// A polygon face of `n` vertices on a unit circle around the floor's centre (x, z), written
+/// with 7 decimals; `notch` pulls one vertex to the centre (non-convex).
+fn polygon_obj(n: usize, notch: bool) -> String {
+    let mut o = String::from(OBJ);
+    o += "o disc\nusemtl white\n";
+    for i in 0..n {
+        let t = std::f64::consts::TAU * i as f64 / n as f64;
+        let (x, z) = if notch && i == n / 2 {
+            (0.0, 0.0)
+        } else {
+            (t.cos(), -t.sin())
+        };
+        o += &format!("v {x:.7} 0.001 {z:.7}\n");
+    }
+    o += "f";
+    for i in 0..n {
+        o += &format!(" {}", i + 9);
+    }
+    o + "\n"
+}
+
+fn absent(rel: &'static str) -> Option<Check> {
+    Some(Box::new(move |d: &Path| {
+        assert!(!d.join(rel).exists(), "{rel} was written");
+    }))
+}
+
+/// Nothing but empty directories at `rel`.
+fn no_files(rel: &'static str) -> Option<Check> {
+    Some(Box::new(move |d: &Path| {
+        fn files(p: &Path) -> usize {
+            std::fs::read_dir(p).map_or(0, |r| {
+                r.flatten()
+                    .map(|e| match e.file_type() {
+                        Ok(t) if t.is_dir() => files(&e.path()),
+                        _ => 1,
+                    })
+                    .sum()
+            })
+        }
+        assert_eq!(files(&d.join(rel)), 0, "{rel} holds files");
+    }))
+}
+
+fn present(rel: &'static str, holds: &'static str) -> Option<Check> {
+    Some(Box::new(move |d: &Path| {
+        let t = std::fs::read_to_string(d.join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
+        assert!(t.contains(holds), "{rel} does not hold `{holds}`: {t}");
+    }))
+}
+
+/// The one photon file of the case's cache, replaced by what `f` makes of its bytes (or a
+/// FIFO for `None`).
+fn damage_photons(d: &Path, f: impl Fn(Vec<u8>) -> Option<Vec<u8>>) {
+    let file = std::fs::read_dir(d.join("cache"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|x| x == "photons"))
+        .expect("a traced photon file");
+    let bytes = std::fs::read(&file).unwrap();
+    std::fs::remove_file(&file).unwrap();
+    match f(bytes) {
+        Some(b) => std::fs::write(&file, b).unwrap(),
+        None => {
+            let made = std::process::Command::new("mkfifo").arg(&file).status();
+            assert!(made.is_ok_and(|s| s.success()));
+        }
+    }
+}
+
+fn cases() -> Vec<Case> {
+    let global = |extra: &str| scene(&format!("[estimate.global]\n{extra}\n"));
+    let mut nan = grey(16, 16);
+    nan.data[3] = [f32::NAN, 0.0, 0.0];
+    nan.data[7] = [0.0, f32::INFINITY, 0.0];
+    nan.data[9] = [0.0, 0.0, f32::NAN];
+    let black = MTL.replace("Kd 0.5 0.5 0.5", "Kd 0 0 0");
+    let mirror = MTL.replace("Kd 0.5 0.5 0.5", "illum 3\nKs 0.9 0.9 0.9");
+    vec![
+        // The photon file (a traced cache, then damaged): estimate names the file.
+        Case {
+            name: "a photon file with a flipped header byte",
+            files: good(),
+            setup: vec!["trace {d}/s.toml --photons 2000 --cache {d}/cache"],
+            prepare: Some(|d| {
+                damage_photons(d, |mut b| {
+                    b[40] ^= 0xff;
+                    Some(b)
+                })
+            }),
+            args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["-global.photons", "checksum mismatch in the header"],
+            check: absent("out"),
+        },
+        Case {
+            name: "a truncated photon file",
+            files: good(),
+            setup: vec!["trace {d}/s.toml --photons 2000 --cache {d}/cache"],
+            prepare: Some(|d| damage_photons(d, |b| Some(b[..100].to_vec()))),
+            args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["-global.photons", "truncated"],
+            check: absent("out"),
+        },
+        Case {
+            name: "a photon file of foreign bytes",
+            files: good(),
+            setup: vec!["trace {d}/s.toml --photons 2000 --cache {d}/cache"],
+            prepare: Some(|d| damage_photons(d, |_| Some(b"not photons at all".to_vec()))),
+            args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["-global.photons", "not a photon file"],
+            check: absent("out"),
+        },
+        Case {
+            name: "a photon file that is a FIFO",
+            files: good(),
+            setup: vec!["trace {d}/s.toml --photons 2000 --cache {d}/cache"],
+            prepare: Some(|d| damage_photons(d, |_| None)),
+            args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["-global.photons", "not a regular file"],
+            check: absent("out"),
+        },
+        Case {
+            name: "estimate without a traced cache",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["-global.photons", "run `trace` first"],
+            check: absent("out"),
+        },
+        // EXR files.
+        Case {
+            name: "compare on bytes that are not EXR",
+            files: vec![
+                ("a.exr", text("garbage")),
+                ("b.exr", Input::Exr(grey(16, 16))),
+            ],
+            setup: vec![],
+            prepare: None,
+            args: "compare {d}/a.exr {d}/b.exr",
+            code: 1,
+            words: &["a.exr", "EXR error"],
+            check: None,
+        },
+        Case {
+            name: "a truncated EXR reference",
+            files: with(good(), "ref.exr", Input::Exr(grey(16, 16))),
+            setup: vec![],
+            prepare: Some(|d| {
+                let p = d.join("ref.exr");
+                let b = std::fs::read(&p).unwrap();
+                std::fs::write(&p, &b[..b.len() / 2]).unwrap();
+            }),
+            args: "render {d}/s.toml --method path --spp 1 --out {d}/out --reference {d}/ref.exr",
+            code: 1,
+            words: &["ref.exr", "EXR error"],
+            check: absent("out"),
+        },
+        Case {
+            name: "an EXR that is a FIFO",
+            files: vec![("a.exr", Input::Fifo), ("b.exr", Input::Exr(grey(16, 16)))],
+            setup: vec![],
+            prepare: None,
+            args: "compare {d}/a.exr {d}/b.exr",
+            code: 1,
+            words: &["a.exr", "not a regular file"],
+            check: None,
+        },
+        Case {
+            name: "compare of two sizes",
+            files: vec![
+                ("a.exr", Input::Exr(grey(16, 16))),
+                ("b.exr", Input::Exr(grey(8, 8))),
+            ],
+            setup: vec![],
+            prepare: None,
+            args: "compare {d}/a.exr {d}/b.exr",
+            code: 1,
+            words: &["16x16", "8x8"],
+            check: None,
+        },
+        // Every command's flags.
+        Case {
+            name: "info on a missing scene",
+            files: vec![],
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/none.toml",
+            code: 1,
+            words: &["none.toml", "cannot read scene file"],
+            check: None,
+        },
+        Case {
+            name: "trace --photons 0",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "trace {d}/s.toml --photons 0 --cache {d}/cache",
+            code: 1,
+            words: &["s.toml", "photons = 0 must be in 1..=2^40"],
+            check: absent("cache"),
+        },
+        Case {
+            name: "render --k 0",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method global-direct --k 0 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["s.toml", "estimate.global.k = 0"],
+            check: absent("out"),
+        },
+        Case {
+            name: "render --topo 2",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method global-direct --topo 2 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["s.toml", "estimate.global.topo = 2 must be in (0, 1]"],
+            check: absent("out"),
+        },
+        Case {
+            name: "render --kernel of no name",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --kernel nope --out {d}/out",
+            code: 2,
+            words: &["--kernel", "unknown kernel `nope`"],
+            check: absent("out"),
+        },
+        Case {
+            name: "render --method of no name",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method nope --out {d}/out",
+            code: 2,
+            words: &["--method", "unknown method `nope`"],
+            check: absent("out"),
+        },
+        Case {
+            name: "render --time -1",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method sppm --time=-1 --out {d}/out",
+            code: 1,
+            words: &["--time -1 must be a positive number of seconds"],
+            check: absent("out"),
+        },
+        Case {
+            name: "render --passes 0",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method sppm --passes 0 --out {d}/out",
+            code: 1,
+            words: &["s.toml", "passes = 0"],
+            check: absent("out"),
+        },
+        Case {
+            name: "render --gather-rays absurd",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method final-gather --gather-rays 100000000 --out {d}/out",
+            code: 1,
+            words: &["s.toml", "final_gather.rays = 100000000 is absurd"],
+            check: absent("out"),
+        },
+        Case {
+            name: "render --spp 0",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method path --spp 0 --out {d}/out",
+            code: 1,
+            words: &["s.toml", "render.spp = 0"],
+            check: absent("out"),
+        },
+        Case {
+            name: "estimate --method path",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "estimate {d}/s.toml --method path --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["estimate reads photon maps", "render --method path"],
+            check: absent("out"),
+        },
+        Case {
+            name: "composite of a directory that is no run",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "composite {d} --out {d}/out",
+            code: 1,
+            words: &["image.json", "cannot read"],
+            check: absent("out"),
+        },
+        Case {
+            name: "worksheet --topo nan",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "worksheet --scene {d}/s.toml --topo nan --reference-spp 1 --out {d}/out --cache {d}/cache",
+            code: 1,
+            words: &["s.toml", "topo = NaN must be in (0, 1]"],
+            check: absent("out"),
+        },
+        Case {
+            name: "worksheet --k 0",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "worksheet --scene {d}/s.toml --k 0 --reference-spp 1 --out {d}/out --cache {d}/cache",
+            code: 1,
+            words: &["s.toml", "estimate.global.k = 0"],
+            check: absent("out"),
+        },
+        Case {
+            name: "evidence --seeds 1",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "evidence {d}/s.toml --seeds 1 --out {d}/out",
+            code: 1,
+            words: &["--seeds 1 must be at least 2"],
+            check: absent("out"),
+        },
+        Case {
+            name: "evidence with a reference of the wrong size",
+            files: with(good(), "ref.exr", Input::Exr(grey(16, 8))),
+            setup: vec![],
+            prepare: None,
+            args: "evidence {d}/s.toml --quick --reference {d}/ref.exr --out {d}/out",
+            code: 1,
+            words: &["ref.exr", "reference is 16x8"],
+            // evidence makes its (empty) directory before it reads the reference.
+            check: no_files("out"),
+        },
+        Case {
+            name: "bench-accuracy --peer without a command",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "bench-accuracy {d}/s.toml --peer bad --dir {d}/out",
+            code: 2,
+            words: &["--peer", "expected NAME=COMMAND"],
+            check: absent("out"),
+        },
+        // Panics.
+        Case {
+            name: "MTL colour of one number is grey",
+            files: with(
+                good(),
+                "m.mtl",
+                text(MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.5")),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 0,
+            words: &[],
+            check: None,
+        },
+        Case {
+            name: "MTL colour of two numbers",
+            files: with(
+                good(),
+                "m.mtl",
+                text(MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.5 0.5")),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &[
+                "m.mtl",
+                "line 2",
+                "`Kd` needs one number (grey) or three",
+                "s.toml",
+            ],
+            check: None,
+        },
+        Case {
+            name: "a mesh scaled to 1e19",
+            files: with(
+                files(scene("[[mesh]]\nobj = \"b.obj\"\nscale = 1e19\n"), OBJ, MTL),
+                "b.obj",
+                text("mtllib m.mtl\no big\nusemtl white\nv -1 0 -1\nv -1 0 1\nv 1 0 1\nf 1 2 3\n"),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &[
+                "b.obj",
+                "beyond the 1e15 scene units",
+                "mesh 1 of",
+                "s.toml",
+            ],
+            check: None,
+        },
+        // Hangs.
+        Case {
+            name: "a convex face of 200k vertices",
+            files: with(good(), "a.obj", text(polygon_obj(200_000, false))),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 0,
+            words: &[],
+            check: None,
+        },
+        Case {
+            name: "a non-convex face of 200k vertices",
+            files: with(good(), "a.obj", text(polygon_obj(200_000, true))),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &[
+                "a.obj",
+                "object `disc`, face 1",
+                "non-convex face of 200000",
+                "s.toml",
+            ],
+            check: None,
+        },
+        Case {
+            name: "a mesh that is a FIFO",
+            files: with(good(), "a.obj", Input::Fifo),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &["a.obj", "not a regular file", "s.toml"],
+            check: None,
+        },
+        Case {
+            name: "a scene file that is a FIFO",
+            files: vec![("s.toml", Input::Fifo)],
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml",
+            code: 1,
+            words: &["s.toml", "not a regular file"],
+            check: None,
+        },
+        Case {
+            name: "photon files that could never fit",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "trace {d}/s.toml --photons 1000000000000 --cache {d}/cache",
+            code: 1,
+            words: &[
+                "s.toml",
+                "1000000000000 photon paths would write",
+                "bytes free",
+                "at most about",
+            ],
+            check: absent("cache/plan.txt"),
+        },
+        // Accepted bad values.
+        Case {
+            name: "r_max negative",
+            files: files(global("r_max = -1.0"), OBJ, MTL),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method global-direct --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["s.toml", "estimate.global.r_max = -1 must be positive"],
+            check: absent("out"),
+        },
+        Case {
+            name: "r_max NaN",
+            files: files(global("r_max = nan"), OBJ, MTL),
+            setup: vec![],
+            prepare: None,
+            args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["s.toml", "r_max = NaN must be positive"],
+            check: absent("out"),
+        },
+        Case {
+            name: "NaN exposure",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method path --spp 1 --out {d}/out --exposure NaN",
+            code: 2,
+            words: &["--exposure", "NaN is not a finite number"],
+            check: absent("out"),
+        },
+        Case {
+            name: "infinite exposure of composite",
+            files: good(),
+            setup: vec!["render {d}/s.toml --method path --spp 1 --out {d}/run"],
+            prepare: None,
+            args: "composite {d}/run --out {d}/out --exposure inf",
+            code: 2,
+            words: &["--exposure", "inf is not a finite number"],
+            check: absent("out"),
+        },
+        Case {
+            name: "--threads 0 when the cache answers",
+            files: good(),
+            setup: vec!["trace {d}/s.toml --photons 2000 --cache {d}/cache"],
+            prepare: None,
+            args: "trace {d}/s.toml --photons 2000 --cache {d}/cache --threads 0",
+            code: 2,
+            words: &["--threads", "must be at least 1"],
+            check: None,
+        },
+        Case {
+            name: "--threads 0 of estimate",
+            files: good(),
+            setup: vec!["trace {d}/s.toml --photons 2000 --cache {d}/cache"],
+            prepare: None,
+            args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out --threads 0",
+            code: 2,
+            words: &["--threads", "must be at least 1"],
+            check: absent("out"),
+        },
+        Case {
+            name: "--reference with --method path is used",
+            files: with(good(), "ref.exr", Input::Exr(grey(16, 16))),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method path --spp 1 --out {d}/out --reference {d}/ref.exr",
+            code: 0,
+            words: &[],
+            check: present("out/image.json", "ref.exr"),
+        },
+        Case {
+            name: "compare with NaN and infinity",
+            files: vec![
+                ("a.exr", Input::Exr(nan)),
+                ("b.exr", Input::Exr(grey(16, 16))),
+            ],
+            setup: vec![],
+            prepare: None,
+            args: "compare {d}/a.exr {d}/b.exr",
+            code: 1,
+            words: &["a.exr", "3 of 256 pixels are not finite"],
+            check: None,
+        },
+        Case {
+            name: "compare with a mask outside the image",
+            files: vec![
+                ("a.exr", Input::Exr(grey(16, 16))),
+                ("b.exr", Input::Exr(grey(16, 16))),
+            ],
+            setup: vec![],
+            prepare: None,
+            args: "compare {d}/a.exr {d}/b.exr --mask 0,0,40,8",
+            code: 1,
+            words: &["a.exr", "--mask 0,0,40,8", "16x16"],
+            check: None,
+        },
+        Case {
+            name: "a mask of the wrong shape",
+            files: vec![],
+            setup: vec![],
+            prepare: None,
+            args: "compare {d}/a.exr {d}/b.exr --mask 1,2",
+            code: 2,
+            words: &["--mask", "expected x0,y0,x1,y1"],
+            check: None,
+        },
+        // Partial output.
+        Case {
+            name: "a missing reference",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method path --spp 1 --out {d}/out --reference {d}/none.exr",
+            code: 1,
+            words: &["none.exr"],
+            check: absent("out"),
+        },
+        Case {
+            name: "a reference of the wrong size",
+            files: with(good(), "ref.exr", Input::Exr(grey(8, 16))),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method sppm --photons 2000 --out {d}/out --reference {d}/ref.exr",
+            code: 1,
+            words: &["ref.exr", "reference is 8x16, the scene renders 16x16"],
+            check: absent("out"),
+        },
+        Case {
+            name: "a reference holding NaN",
+            files: with(
+                good(),
+                "ref.exr",
+                Input::Exr({
+                    let mut i = grey(16, 16);
+                    i.data[0] = [f32::NAN; 3];
+                    i
+                }),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method path --spp 1 --out {d}/out --reference {d}/ref.exr",
+            code: 1,
+            words: &["ref.exr", "1 of 256 reference pixels are not finite"],
+            check: absent("out"),
+        },
+        Case {
+            name: "bench accuracy with a reference of the wrong size",
+            files: with(good(), "ref.exr", Input::Exr(grey(16, 8))),
+            setup: vec![],
+            prepare: None,
+            args: "bench-accuracy {d}/s.toml --reference {d}/ref.exr --dir {d}/out",
+            code: 1,
+            words: &["ref.exr", "reference is 16x8"],
+            check: absent("out"),
+        },
+        // Messages.
+        Case {
+            name: "an empty OBJ",
+            files: with(good(), "a.obj", text("")),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &["a.obj", "the OBJ file is empty", "s.toml"],
+            check: None,
+        },
+        Case {
+            name: "an OBJ without mtllib",
+            files: with(good(), "a.obj", text(OBJ.replace("mtllib m.mtl\n", ""))),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &[
+                "a.obj",
+                "`usemtl white` (line 2)",
+                "no `mtllib` line",
+                "s.toml",
+            ],
+            check: None,
+        },
+        Case {
+            name: "usemtl of an unknown material",
+            files: with(
+                good(),
+                "a.obj",
+                text(OBJ.replace("usemtl light", "usemtl lamp")),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &[
+                "a.obj",
+                "`usemtl lamp` (line 11): unknown material",
+                "m.mtl defines `white`, `light`",
+                "s.toml",
+            ],
+            check: None,
+        },
+        Case {
+            name: "faces before any usemtl",
+            files: with(good(), "a.obj", text(OBJ.replace("usemtl white\n", ""))),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &[
+                "a.obj",
+                "object `floor` has faces before any `usemtl` line",
+                "s.toml",
+            ],
+            check: None,
+        },
+        Case {
+            name: "a malformed scene file spans one line",
+            files: vec![("s.toml", text("[camera\neye = 1\n"))],
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &["s.toml", "malformed scene file", "line 1"],
+            check: None,
+        },
+        Case {
+            name: "an unknown flag spans one line",
+            files: vec![],
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --bogus",
+            code: 2,
+            words: &["--bogus", "(see --help)"],
+            check: None,
+        },
+        // Valid scenes refused.
+        Case {
+            name: "all surfaces black, final gathering",
+            files: files(scene(""), OBJ, &black),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method final-gather --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 0,
+            words: &[],
+            check: present("out/plan.txt", "no surface is diffuse"),
+        },
+        Case {
+            name: "only mirrors, final gathering",
+            files: files(scene(""), OBJ, &mirror),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method final-gather --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 0,
+            words: &[],
+            check: present(
+                "out/plan.txt",
+                "only emitters, seen directly or through specular",
+            ),
+        },
+        Case {
+            name: "only mirrors, sppm",
+            files: files(scene(""), OBJ, &mirror),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method sppm --photons 2000 --out {d}/out",
+            code: 0,
+            words: &[],
+            check: present("out/plan.txt", "no surface is diffuse"),
+        },
+        // Temporary files.
+        Case {
+            name: "a stale temp file of a dead process",
+            files: with(good(), "cache/x.photons.tmp-999999999-0", text("partial")),
+            setup: vec![],
+            prepare: None,
+            args: "trace {d}/s.toml --photons 2000 --cache {d}/cache",
+            code: 0,
+            words: &[],
+            check: absent("cache/x.photons.tmp-999999999-0"),
+        },
+    ]
+}
+
+/// Runs `args` in process on a thread; `None` if it did not return within the timeout.
+fn run(args: &str, dir: &Path) -> Option<std::thread::Result<(u8, Option<String>)>> {
+    let argv: Vec<String> = std::iter::once("photonflow".to_string())
+        .chain(
+            args.split(' ')
+                .map(|a| a.replace("{d}", &dir.display().to_string())),
+        )
+        .collect();
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let r = std::panic::catch_unwind(|| photonflow::run_args(argv));
+        let _ = tx.send(r);
+    });
+    rx.recv_timeout(Duration::from_secs(120)).ok()
+}
+
+#[test]
+fn bad_input_table() {
+    let tmp = TempDir::new("bad-input");
+    let mut failures = Vec::new();
+    let cases = cases();
+    let n = cases.len();
+    for (i, case) in cases.into_iter().enumerate() {
+        let dir = tmp.path().join(format!("case-{i:02}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (name, input) in &case.files {
+            let p = dir.join(name);
+            if let Some(parent) = p.parent() {
+                std::fs::create_dir_all(parent).unwrap();
+            }
+            match input {
+                Input::Text(t) => std::fs::write(&p, t).unwrap(),
+                Input::Exr(img) => film::write_exr(&p, img).unwrap(),
+                Input::Fifo => {
+                    let made = std::process::Command::new("mkfifo").arg(&p).status();
+                    assert!(made.is_ok_and(|s| s.success()), "mkfifo {}", p.display());
+                }
+            }
+        }
+        for s in &case.setup {
+            match run(s, &dir) {
+                Some(Ok((0, _))) => {}
+                other => panic!("{}: setup `{s}` failed: {other:?}", case.name),
+            }
+        }
+        if let Some(prepare) = case.prepare {
+            prepare(&dir);
+        }
+        let what = match run(case.args, &dir) {
+            None => Err("hung (no answer in 120 s)".to_string()),
+            Some(Err(_)) => Err("panicked".to_string()),
+            Some(Ok((code, msg))) => {
+                let msg = msg.unwrap_or_default();
+                let missing: Vec<&&str> =
+                    case.words.iter().filter(|w| !msg.contains(**w)).collect();
+                if code != case.code {
+                    Err(format!("exit {code}, expected {}: {msg}", case.code))
+                } else if msg.contains('\n') {
+                    Err(format!("message spans lines: {msg}"))
+                } else if !missing.is_empty() {
+                    Err(format!("message lacks {missing:?}: {msg}"))
+                } else if case.code != 0 && !msg.starts_with("error: ") {
+                    Err(format!("not an error line: {msg}"))
+                } else {
+                    Ok(())
+                }
+            }
+        };
+        let what = what.and_then(|()| match &case.check {
+            Some(check) => std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| check(&dir)))
+                .map_err(|e| {
+                    e.downcast_ref::<String>()
+                        .cloned()
+                        .unwrap_or_else(|| "check failed".into())
+                }),
+            None => Ok(()),
+        });
+        if let Err(e) = what {
+            failures.push(format!("{}: {e}", case.name));
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {n} cases failed:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}

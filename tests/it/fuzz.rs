@@ -1,0 +1,40 @@
+//! The fuzz loops of `tests::fuzz` at the size `cargo test` affords: 1,000 mutated inputs per
+//! loader (OBJ, MTL, scene file, photon file, EXR), each one answered without a panic, a hang
+//! or an allocation sized by an unchecked field. `cargo xtask fuzz --seconds N` runs more.
+
+use tests::TempDir;
+use tests::fuzz::{Budget, Target, run};
+
+fn fuzz(t: Target) {
+    let dir = TempDir::new(&format!("fuzz-{}", t.name()));
+    let s = run(t, 0x5EED, Budget::Cases(1000), dir.path()).unwrap_or_else(|e| panic!("{e}"));
+    eprintln!("{}: {s:?}", t.name());
+    assert_eq!(s.cases, 1000);
+    // The mutations reach past the first check: some inputs still load, most are refused.
+    assert!(s.accepted > 0 && s.accepted < s.cases, "{s:?}");
+}
+
+#[test]
+fn obj_loader_survives_mutations() {
+    fuzz(Target::Obj);
+}
+
+#[test]
+fn mtl_reader_survives_mutations() {
+    fuzz(Target::Mtl);
+}
+
+#[test]
+fn scene_file_parser_survives_mutations() {
+    fuzz(Target::Scene);
+}
+
+#[test]
+fn photon_file_readers_survive_mutations() {
+    fuzz(Target::Photons);
+}
+
+#[test]
+fn exr_reader_survives_mutations() {
+    fuzz(Target::Exr);
+}
