@@ -594,8 +594,9 @@ fn interrupted_traces_leave_no_temp_files() {
             .collect()
     };
     // SIGINT and SIGKILL, each at several moments while the photon files are being written
-    // (0 to 0.6 s after the first temporary file appears; the trace would take minutes).
-    for (i, signal) in ["-INT", "-KILL", "-INT", "-KILL", "-KILL", "-INT"]
+    // (0 to 0.72 s after its first temporary file appears; the trace would take minutes),
+    // ending with a kill -9 whose file the last run must remove.
+    for (i, signal) in ["-INT", "-KILL", "-INT", "-KILL", "-KILL", "-INT", "-KILL"]
         .iter()
         .enumerate()
     {
@@ -632,7 +633,7 @@ fn interrupted_traces_leave_no_temp_files() {
         // read as a photon set.
         let published: Vec<String> = names()
             .into_iter()
-            .filter(|n| !n.contains(".tmp-"))
+            .filter(|n| n.ends_with(".photons"))
             .collect();
         assert_eq!(published, Vec::<String>::new(), "{signal} at moment {i}");
         if *signal == "-INT" {
