@@ -205,6 +205,7 @@ fn the_report_links_resolve_and_a_browser_shows_its_images() {
         seeds: 2,
         quick: true,
         budget_scale: 0.02,
+        only: Vec::new(),
         out: out.clone(),
         threads: None,
     })

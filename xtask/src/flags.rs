@@ -23,7 +23,8 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
                       worksheet 7's images (box kernel, Silverman, + topological test,
                       + boundary correction) with errors against a path-traced reference,
                       summarised in out/worksheet/README.md
-  evidence [SCENE] [--quick] [--seeds K] [--budget-scale F] [--reference EXR] [--reference-spp N]
+  evidence [SCENE] [--quick] [--seeds K] [--budget-scale F] [--only NAME]... [--reference EXR]
+           [--reference-spp N]
                       each technique over a ladder of budgets, K seeds each, against a
                       reference: relMSE (two conventions), RMSE, mean ratio, FLIP, bias^2 and
                       variance per region (caustic, edges and corners, outer rim, glass sphere,

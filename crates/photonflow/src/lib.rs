@@ -161,6 +161,10 @@ enum Cmd {
         /// Multiply every budget of the ladder and the k sweep's photon counts by this.
         #[arg(long, default_value_t = 1.0)]
         budget_scale: f64,
+        /// Only this technique (repeatable; its name in lower case with dashes, e.g.
+        /// `path`, `caustic-map-k-nn`, or `k-sweep`).
+        #[arg(long)]
+        only: Vec<String>,
         #[arg(long, default_value = "out/evidence")]
         out: PathBuf,
         #[arg(long, value_parser = parse_threads)]
@@ -519,6 +523,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
             seeds,
             quick,
             budget_scale,
+            only,
             out,
             threads,
         } => pipeline::evidence::run(&pipeline::evidence::EvidenceArgs {
@@ -528,6 +533,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
             seeds,
             quick,
             budget_scale,
+            only,
             out,
             threads,
         }),

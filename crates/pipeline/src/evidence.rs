@@ -25,6 +25,8 @@ pub struct EvidenceArgs {
     pub quick: bool,
     /// Every budget (and the k sweep's photon count) times this, at least 1.
     pub budget_scale: f64,
+    /// Only these techniques (their names' slugs, `k-sweep` for the sweep); empty: all.
+    pub only: Vec<String>,
     pub out: PathBuf,
     pub threads: Option<usize>,
 }
@@ -461,7 +463,19 @@ pub fn run(a: &EvidenceArgs) -> Result<(), String> {
         sweep_photons: scale(200_000),
         skipped: Vec::new(),
     };
-    for mut t in techniques(a.quick) {
+    let wanted = |name: &str| a.only.is_empty() || a.only.iter().any(|o| slug(o) == slug(name));
+    let known: Vec<String> = techniques(a.quick)
+        .iter()
+        .map(|t| slug(t.name))
+        .chain(["k-sweep".to_string()])
+        .collect();
+    if let Some(o) = a.only.iter().find(|o| !known.contains(&slug(o))) {
+        return Err(format!(
+            "--only {o}: no such technique (known: {})",
+            known.join(", ")
+        ));
+    }
+    for mut t in techniques(a.quick).into_iter().filter(|t| wanted(t.name)) {
         t.ladder = t.ladder.iter().map(|&n| scale(n)).collect();
         t.ladder.dedup();
         let (reference, regions) = match t.layer {
@@ -493,7 +507,9 @@ pub fn run(a: &EvidenceArgs) -> Result<(), String> {
             ev.rungs.push(r);
         }
     }
-    k_sweep(a, &make, &reference.image, &regions, &cache, &mut ev)?;
+    if wanted("k-sweep") {
+        k_sweep(a, &make, &reference.image, &regions, &cache, &mut ev)?;
+    }
     crate::report::write(&a.out, &ev, &scene, &regions)?;
     println!(
         "wrote {} and report.html, evidence.md (tables), evidence.json, maps/, plots/",
