@@ -24,6 +24,20 @@
 //! reflectance = [0.96, 0.98, 0.96]
 //! ```
 
+// A decoder of untrusted bytes: no input may reach a panic, so the lints that find the ways
+// to one (unwrap, expect, indexing, explicit panics) are errors here; `cargo clippy` is the
+// check.
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::indexing_slicing,
+        clippy::panic,
+        clippy::unreachable
+    )
+)]
+
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 

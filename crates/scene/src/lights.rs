@@ -82,7 +82,19 @@ pub struct LightTable {
 }
 
 impl LightTable {
-    /// `None` when no light has positive, finite power (scene loading refuses such scenes).
+    /// `None` when no light has positive, finite power (scene loading refuses such scenes) or
+    /// a light names a triangle `mesh` lacks (loading builds lights from the mesh's triangles).
+    // Built from loaded data: the loaders' lints (see `load.rs`) hold here too.
+    #[cfg_attr(
+        not(test),
+        deny(
+            clippy::unwrap_used,
+            clippy::expect_used,
+            clippy::indexing_slicing,
+            clippy::panic,
+            clippy::unreachable
+        )
+    )]
     pub fn new(mesh: &TriMesh, lights: &[AreaLight]) -> Option<LightTable> {
         let power: Vec<DVec3> = lights
             .iter()
@@ -94,22 +106,21 @@ impl LightTable {
             return None;
         }
         let mut light_of_triangle = vec![NOT_A_LIGHT; mesh.len()];
+        for (i, l) in lights.iter().enumerate() {
+            *light_of_triangle.get_mut(l.triangle as usize)? = i as u32;
+        }
         let entries = lights
             .iter()
             .zip(&power)
             .zip(&weights)
-            .enumerate()
-            .map(|(i, ((l, &power), w))| {
-                light_of_triangle[l.triangle as usize] = i as u32;
-                Entry {
-                    vertices: mesh.vertices(l.triangle as usize),
-                    normal: l.normal,
-                    area: l.area,
-                    le: l.le,
-                    frame: Frame::from_z(l.normal),
-                    power,
-                    pmf: w / sum,
-                }
+            .map(|((l, &power), w)| Entry {
+                vertices: mesh.vertices(l.triangle as usize),
+                normal: l.normal,
+                area: l.area,
+                le: l.le,
+                frame: Frame::from_z(l.normal),
+                power,
+                pmf: w / sum,
             })
             .collect();
         Some(LightTable {

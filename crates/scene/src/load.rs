@@ -1,3 +1,17 @@
+// A decoder of untrusted bytes: no input may reach a panic, so the lints that find the ways
+// to one (unwrap, expect, indexing, explicit panics) are errors here; `cargo clippy` is the
+// check.
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::indexing_slicing,
+        clippy::panic,
+        clippy::unreachable
+    )
+)]
+
 use crate::file::{EmissionSource, MaterialDesc, MeshDesc, NormalMode, Scale, SceneFile};
 use crate::{Camera, LightTable, Material, RenderSettings, SceneError};
 use bsdf::Bsdf;
@@ -170,8 +184,15 @@ impl Scene {
 fn location(text: &str, span: Option<std::ops::Range<usize>>) -> String {
     match span {
         Some(r) => {
-            let line = text[..r.start.min(text.len())].matches('\n').count() + 1;
-            let snippet = text[r.clone()].lines().next().unwrap_or("").trim();
+            let before = text.as_bytes().get(..r.start).unwrap_or(text.as_bytes());
+            let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+            let snippet = text
+                .get(r)
+                .unwrap_or("")
+                .lines()
+                .next()
+                .unwrap_or("")
+                .trim();
             format!(" (line {line}: `{snippet}`)")
         }
         None => String::new(),
@@ -250,6 +271,17 @@ impl<'a> Builder<'a> {
         SceneError::new(self.scene_path, problem)
     }
 
+    /// Material `id`'s entry in a per-material table. Every id in the mesh and the spheres came
+    /// from `add_material` or `by_name`, so a miss is a loader bug: an error, never a panic.
+    fn of_material<'t, T>(&self, table: &'t [T], id: u32) -> Result<&'t T, SceneError> {
+        table.get(id as usize).ok_or_else(|| {
+            self.err(format!(
+                "internal error: material id {id} of {} materials",
+                table.len()
+            ))
+        })
+    }
+
     fn build(mut self, file: SceneFile) -> Result<Scene, SceneError> {
         self.validate_materials()?;
         for (i, m) in file.meshes.iter().enumerate() {
@@ -312,8 +344,8 @@ impl<'a> Builder<'a> {
         }
 
         let mut lights = Vec::new();
-        for t in 0..self.mesh.len() {
-            let e = self.emission[self.mesh.materials[t] as usize];
+        for (t, &mat) in self.mesh.materials.iter().enumerate() {
+            let e = *self.of_material(&self.emission, mat)?;
             if e.max_element() <= 0.0 {
                 continue;
             }
@@ -321,7 +353,7 @@ impl<'a> Builder<'a> {
             // In f64: an f32 cross product of a huge triangle overflows while normalising.
             let [p0, p1, p2] = self.mesh.vertices(t).map(|p| p.as_dvec3());
             let n = (p1 - p0).cross(p2 - p0).normalize_or_zero().as_vec3();
-            let name = &self.names[self.mesh.materials[t] as usize];
+            let name = self.of_material(&self.names, mat)?;
             if area.is_infinite() || !n.is_finite() {
                 return Err(self.err(format!(
                     "light triangle {t} (material `{name}`) is too large for f32 (area {area}): \
@@ -367,12 +399,10 @@ impl<'a> Builder<'a> {
             };
             return Err(self.err(format!("the scene has no light: no triangle emits{hint}")));
         }
-        if self
-            .spheres
-            .iter()
-            .any(|s| self.emission[s.material as usize].max_element() > 0.0)
-        {
-            return Err(self.err("emissive spheres are not supported: lights are triangles"));
+        for s in &self.spheres {
+            if self.of_material(&self.emission, s.material)?.max_element() > 0.0 {
+                return Err(self.err("emissive spheres are not supported: lights are triangles"));
+            }
         }
 
         let Some(light_table) = LightTable::new(&self.mesh, &lights) else {
@@ -565,8 +595,8 @@ impl<'a> Builder<'a> {
             }
             let nv = m.positions.len() / 3;
             let mut part = TriMesh::default();
-            for (v, p) in m.positions.chunks_exact(3).enumerate() {
-                let p = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+            for (v, &[x, y, z]) in m.positions.as_chunks::<3>().0.iter().enumerate() {
+                let p = DVec3::new(x as f64, y as f64, z as f64);
                 if !p.is_finite() {
                     return Err(oerr(format!(
                         "object `{}`: vertex {} is not finite ({:?})",
@@ -590,8 +620,8 @@ impl<'a> Builder<'a> {
             let use_file_normals =
                 matches!(desc.normals, NormalMode::Auto) && m.normals.len() == 3 * nv;
             if use_file_normals {
-                for (v, n) in m.normals.chunks_exact(3).enumerate() {
-                    let n = DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64);
+                for (v, &[x, y, z]) in m.normals.as_chunks::<3>().0.iter().enumerate() {
+                    let n = DVec3::new(x as f64, y as f64, z as f64);
                     let n = (nxf * n).normalize_or_zero();
                     if !n.is_finite() || n == DVec3::ZERO {
                         return Err(oerr(format!(
@@ -603,9 +633,9 @@ impl<'a> Builder<'a> {
                     part.normals.push(n.as_vec3());
                 }
             }
-            let mat = match m.material_id {
-                Some(i) if i < mat_ids.len() => mat_ids[i],
-                Some(i) => {
+            let mat = match m.material_id.map(|i| (i, mat_ids.get(i))) {
+                Some((_, Some(&id))) => id,
+                Some((i, None)) => {
                     return Err(oerr(format!(
                         "object `{}` uses material index {i} that its MTL does not define",
                         model.name
@@ -725,13 +755,12 @@ fn grey_colours(bytes: &[u8]) -> Result<Vec<u8>, String> {
         if let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke" | "Tf")) = key {
             let args: Vec<&str> = words.collect();
             let numbers = args.iter().take_while(|w| w.parse::<f32>().is_ok()).count();
-            match (args.len(), numbers) {
-                (1, 1) => {
-                    let v = args[0];
+            match (args.as_slice(), numbers) {
+                ([v], 1) => {
                     out.push_str(&format!("{key} {v} {v} {v}\n"));
                     continue;
                 }
-                (0, _) | (2, 2) => {
+                ([], _) | ([_, _], 2) => {
                     return Err(format!(
                         "line {}: `{key}` needs one number (grey) or three (RGB), got {}",
                         i + 1,

@@ -7,6 +7,20 @@
 //! them small and local. Non-convex faces are ear-clipped, which is quadratic or worse in their
 //! size, so only up to [`MAX_NONCONVEX`] vertices; larger ones are refused with a clear error.
 
+// A decoder of untrusted bytes: no input may reach a panic, so the lints that find the ways
+// to one (unwrap, expect, indexing, explicit panics) are errors here; `cargo clippy` is the
+// check.
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::indexing_slicing,
+        clippy::panic,
+        clippy::unreachable
+    )
+)]
+
 use glam::{DVec2, DVec3, Vec3};
 
 /// Largest non-convex face that is ear-clipped (at most n^3 / 6 point tests: about 3M here,
@@ -18,26 +32,30 @@ pub const MAX_NONCONVEX: usize = 256;
 /// faces get the balanced split.
 const FAN_MAX: usize = 16;
 
-/// Appends the triangles of the polygon `face` (indices into `pos`, all in range: the caller
-/// checks) to `out`. Faces of fewer than three vertices (points, lines) add nothing.
+/// Appends the triangles of the polygon `face` (indices into `pos`; the caller checks they are
+/// in range, and one that is not is an error) to `out`. Faces of fewer than three vertices
+/// (points, lines) add nothing.
 pub(crate) fn triangulate(
     face: &[u32],
     pos: &[Vec3],
     out: &mut Vec<[u32; 3]>,
 ) -> Result<(), String> {
+    match *face {
+        [] | [_] | [_, _] => return Ok(()),
+        [a, b, c] => {
+            out.push([a, b, c]);
+            return Ok(());
+        }
+        _ => {}
+    }
     let n = face.len();
-    if n < 3 {
-        return Ok(());
-    }
-    if n == 3 {
-        out.push([face[0], face[1], face[2]]);
-        return Ok(());
-    }
-    let p = project(face, pos);
+    let p = project(face, pos)?;
     if is_convex(&p) {
-        if n <= FAN_MAX {
-            for i in 1..n - 1 {
-                out.push([face[0], face[i], face[i + 1]]);
+        if let Some((&first, rest)) = face.split_first()
+            && n <= FAN_MAX
+        {
+            for (&b, &c) in rest.iter().zip(rest.iter().skip(1)) {
+                out.push([first, b, c]);
             }
         } else {
             balanced(face, out);
@@ -54,32 +72,49 @@ pub(crate) fn triangulate(
     Ok(())
 }
 
+/// Each vertex with the next one, the last with the first.
+fn edges<T>(v: &[T]) -> impl Iterator<Item = (&T, &T)> {
+    v.iter().zip(v.iter().cycle().skip(1))
+}
+
 /// The face's vertices in 2D, in its plane (Newell's normal; the axis it points along most is
 /// dropped), oriented counter-clockwise.
-fn project(face: &[u32], pos: &[Vec3]) -> Vec<DVec2> {
-    let v = |i: usize| pos[face[i] as usize].as_dvec3();
-    let o = v(0);
+fn project(face: &[u32], pos: &[Vec3]) -> Result<Vec<DVec2>, String> {
+    let v = face
+        .iter()
+        .map(|&i| {
+            pos.get(i as usize).map(|p| p.as_dvec3()).ok_or_else(|| {
+                format!(
+                    "vertex {} is out of range ({} vertices)",
+                    i as u64 + 1,
+                    pos.len()
+                )
+            })
+        })
+        .collect::<Result<Vec<DVec3>, String>>()?;
+    let Some(&o) = v.first() else {
+        return Ok(Vec::new());
+    };
     let mut normal = DVec3::ZERO;
-    for i in 0..face.len() {
-        let a = v(i) - o;
-        let b = v((i + 1) % face.len()) - o;
-        normal += a.cross(b);
+    for (&a, &b) in edges(&v) {
+        normal += (a - o).cross(b - o);
     }
     let a = normal.abs();
-    let (x, y, s) = if a.z >= a.x && a.z >= a.y {
-        (0, 1, normal.z)
+    // The two kept coordinates, in order, and the dropped axis's normal component.
+    let (keep, s): (fn(DVec3) -> DVec2, f64) = if a.z >= a.x && a.z >= a.y {
+        (|d| DVec2::new(d.x, d.y), normal.z)
     } else if a.x >= a.y {
-        (1, 2, normal.x)
+        (|d| DVec2::new(d.y, d.z), normal.x)
     } else {
-        (2, 0, normal.y)
+        (|d| DVec2::new(d.z, d.x), normal.y)
     };
     let flip = if s < 0.0 { -1.0 } else { 1.0 };
-    (0..face.len())
-        .map(|i| {
-            let d = (v(i) - o).to_array();
-            DVec2::new(flip * d[x], d[y])
+    Ok(v.iter()
+        .map(|&p| {
+            let d = keep(p - o);
+            DVec2::new(flip * d.x, d.y)
         })
-        .collect()
+        .collect())
 }
 
 /// Convex, to within rounding: the face's area (shoelace, counter-clockwise) equals its convex
@@ -88,8 +123,7 @@ fn project(face: &[u32], pos: &[Vec3]) -> Vec<DVec2> {
 /// itself has turns of one sign only near its crossings. O(n log n) (a sort). A face with no
 /// area at all counts as convex: any split of it is as degenerate as the face.
 fn is_convex(p: &[DVec2]) -> bool {
-    let n = p.len();
-    let area: f64 = (0..n).map(|i| p[i].perp_dot(p[(i + 1) % n])).sum::<f64>() / 2.0;
+    let area: f64 = edges(p).map(|(a, b)| a.perp_dot(*b)).sum::<f64>() / 2.0;
     let hull = hull_area(p);
     if hull <= 0.0 {
         return true;
@@ -114,8 +148,8 @@ fn hull_area(p: &[DVec2]) -> f64 {
             Box::new(pts.iter().rev())
         };
         for &q in iter {
-            while hull.len() >= start + 2 {
-                let (a, b) = (hull[hull.len() - 2], hull[hull.len() - 1]);
+            // The last two points of this chain, while it has two.
+            while let Some(&[a, b]) = hull.get(start..).and_then(|c| c.last_chunk::<2>()) {
                 if (b - a).perp_dot(q - b) <= 0.0 {
                     hull.pop();
                 } else {
@@ -127,55 +161,60 @@ fn hull_area(p: &[DVec2]) -> f64 {
         // The last point of each chain is the first of the next.
         hull.pop();
     }
-    let m = hull.len();
-    (0..m)
-        .map(|i| hull[i].perp_dot(hull[(i + 1) % m]))
-        .sum::<f64>()
-        / 2.0
+    edges(&hull).map(|(a, b)| a.perp_dot(*b)).sum::<f64>() / 2.0
 }
 
-/// A convex face split in halves: triangle (i, m, j) with m the middle of the chain i..j, then
-/// both halves. Iterative, O(n); keeps the face's winding.
+/// A convex face split in halves: triangle (first, middle, last) of a chain of vertices, then
+/// both halves, which share the middle vertex. Iterative, O(n); keeps the face's winding.
 fn balanced(face: &[u32], out: &mut Vec<[u32; 3]>) {
-    let mut stack = vec![(0usize, face.len() - 1)];
-    while let Some((i, j)) = stack.pop() {
-        if j - i < 2 {
+    let mut stack = vec![face];
+    while let Some(chain) = stack.pop() {
+        if chain.len() < 3 {
             continue;
         }
-        let m = i + (j - i) / 2;
-        out.push([face[i], face[m], face[j]]);
-        stack.push((i, m));
-        stack.push((m, j));
+        let m = (chain.len() - 1) / 2;
+        if let (Some(left @ [a, ..]), Some(right @ [b, .., c])) = (chain.get(..=m), chain.get(m..))
+        {
+            out.push([*a, *b, *c]);
+            stack.push(left);
+            stack.push(right);
+        }
     }
 }
 
 /// Ear clipping of a counter-clockwise polygon. A face with no ear left (self-intersecting or
 /// degenerate) is finished as a fan, as tobj would have, so every face gives n - 2 triangles.
 fn ear_clip(face: &[u32], p: &[DVec2], out: &mut Vec<[u32; 3]>) {
-    let mut idx: Vec<usize> = (0..face.len()).collect();
-    while idx.len() > 3 {
-        let m = idx.len();
-        let ear = (0..m).find(|&k| {
-            let (a, b, c) = (idx[(k + m - 1) % m], idx[k], idx[(k + 1) % m]);
-            if (p[b] - p[a]).perp_dot(p[c] - p[b]) <= 0.0 {
+    // The polygon left to clip: each vertex with its projected point.
+    let mut ring: Vec<(u32, DVec2)> = face.iter().copied().zip(p.iter().copied()).collect();
+    while ring.len() > 3 {
+        let m = ring.len();
+        // The corner at ring position k: the previous vertex, k and the next, with positions.
+        let corner = |k: usize| -> Option<[(usize, (u32, DVec2)); 3]> {
+            let (i, j) = ((k + m - 1) % m, (k + 1) % m);
+            Some([(i, *ring.get(i)?), (k, *ring.get(k)?), (j, *ring.get(j)?)])
+        };
+        let is_ear = |k: usize| {
+            let Some([(ia, (_, a)), (ib, (_, b)), (ic, (_, c))]) = corner(k) else {
+                return false;
+            };
+            if (b - a).perp_dot(c - b) <= 0.0 {
                 return false;
             }
-            !idx.iter().any(|&q| {
-                q != a
-                    && q != b
-                    && q != c
-                    && p[q] != p[a]
-                    && p[q] != p[b]
-                    && p[q] != p[c]
-                    && inside(p[q], p[a], p[b], p[c])
+            !ring.iter().enumerate().any(|(iq, &(_, q))| {
+                iq != ia && iq != ib && iq != ic && q != a && q != b && q != c && inside(q, a, b, c)
             })
-        });
-        let k = ear.unwrap_or(0);
-        let (a, b, c) = (idx[(k + m - 1) % m], idx[k], idx[(k + 1) % m]);
-        out.push([face[a], face[b], face[c]]);
-        idx.remove(k);
+        };
+        let k = (0..m).find(|&k| is_ear(k)).unwrap_or(0);
+        let Some([(_, (a, _)), (_, (b, _)), (_, (c, _))]) = corner(k) else {
+            break;
+        };
+        out.push([a, b, c]);
+        ring.remove(k);
     }
-    out.push([face[idx[0]], face[idx[1]], face[idx[2]]]);
+    if let [(a, _), (b, _), (c, _)] = *ring {
+        out.push([a, b, c]);
+    }
 }
 
 /// `q` inside or on the counter-clockwise triangle (a, b, c).

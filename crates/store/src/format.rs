@@ -35,6 +35,20 @@
 //! Every offset of a record is a multiple of 32 (H, chunk headers and records are), so a record
 //! never straddles a cache line and a page-aligned memory map casts to `&[Photon]` in place.
 
+// A decoder of untrusted bytes: no input may reach a panic, so the lints that find the ways
+// to one (unwrap, expect, indexing, explicit panics) are errors here; `cargo clippy` is the
+// check.
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::indexing_slicing,
+        clippy::panic,
+        clippy::unreachable
+    )
+)]
+
 use crate::error::Problem;
 use crate::{MapKind, Photon};
 
@@ -187,18 +201,32 @@ pub fn encode_header(h: &Header, capacity: u32, chunk_count: u32) -> Vec<u8> {
     b
 }
 
-fn u32_at(b: &[u8], at: usize) -> u32 {
-    u32::from_le_bytes(b[at..at + 4].try_into().unwrap())
+/// The `N` bytes of `b` from `at`. Callers check a block's length before reading its fields,
+/// so a field past the end is a decoder bug; it is still an error, never a panic.
+fn field<const N: usize>(b: &[u8], at: usize) -> Result<[u8; N], Problem> {
+    b.get(at..)
+        .and_then(|rest| rest.first_chunk::<N>())
+        .copied()
+        .ok_or_else(|| {
+            Problem::Corrupt(format!(
+                "a {N}-byte field at byte {at} runs past the {}-byte block",
+                b.len()
+            ))
+        })
 }
 
-fn u64_at(b: &[u8], at: usize) -> u64 {
-    u64::from_le_bytes(b[at..at + 8].try_into().unwrap())
+fn u32_at(b: &[u8], at: usize) -> Result<u32, Problem> {
+    field(b, at).map(u32::from_le_bytes)
+}
+
+fn u64_at(b: &[u8], at: usize) -> Result<u64, Problem> {
+    field(b, at).map(u64::from_le_bytes)
 }
 
 /// Checks magic and version (in that order, before anything whose meaning the version could
 /// change) and returns the header length. `b` is the file's first bytes, `len` its length.
 pub fn decode_prefix(b: &[u8], len: u64) -> Result<u64, Problem> {
-    if b.len() < MAGIC.len() || b[..8] != MAGIC {
+    if b.first_chunk::<8>() != Some(&MAGIC) {
         return Err(Problem::NotPhotonFile);
     }
     if b.len() < PREFIX_LEN {
@@ -208,11 +236,11 @@ pub fn decode_prefix(b: &[u8], len: u64) -> Result<u64, Problem> {
             len,
         });
     }
-    let version = u32_at(b, 8);
+    let version = u32_at(b, 8)?;
     if version != FORMAT_VERSION {
         return Err(Problem::Version { found: version });
     }
-    let header_len = u32_at(b, 12);
+    let header_len = u32_at(b, 12)?;
     let least = (FIXED_LEN + 4).next_multiple_of(32) as u32;
     if header_len < least || !header_len.is_multiple_of(32) || header_len > MAX_HEADER_LEN {
         return Err(Problem::Corrupt(format!(
@@ -232,47 +260,57 @@ pub fn decode_prefix(b: &[u8], len: u64) -> Result<u64, Problem> {
 /// Decodes the whole header block `b` (as long as `decode_prefix` said), checksum first.
 pub fn decode_header(b: &[u8]) -> Result<(Header, Chunks), Problem> {
     let n = b.len();
-    if crc32fast::hash(&b[..n - 4]) != u32_at(b, n - 4) {
+    // `decode_prefix` admits no header this short; a caller that skipped it gets an error.
+    let (body, crc) = match b.split_last_chunk::<4>() {
+        Some((body, crc)) if n >= FIXED_LEN + 4 => (body, u32::from_le_bytes(*crc)),
+        _ => {
+            return Err(Problem::Corrupt(format!(
+                "a header of {n} bytes is shorter than its fixed fields"
+            )));
+        }
+    };
+    if crc32fast::hash(body) != crc {
         return Err(Problem::HeaderChecksum);
     }
     // Past the checksum, a bad field means a writer bug or a forged file, not bit rot.
     let corrupt = |what: &str| Problem::Corrupt(what.to_string());
-    let layout_len = u16::from_le_bytes([b[70], b[71]]) as usize;
-    let params_len = u32_at(b, 72) as usize;
-    if FIXED_LEN + layout_len + params_len + 4 > n {
+    let layout_len = u16::from_le_bytes(field(b, 70)?) as usize;
+    let params_len = u32_at(b, 72)? as usize;
+    let strings_end = FIXED_LEN + layout_len + params_len;
+    // The strings end within `body` (before the checksum), then zero padding.
+    let (Some(layout), Some(params), Some(padding)) = (
+        body.get(FIXED_LEN..FIXED_LEN + layout_len),
+        body.get(FIXED_LEN + layout_len..strings_end),
+        body.get(strings_end..),
+    ) else {
         return Err(corrupt("header strings overrun the header"));
-    }
-    let layout = &b[FIXED_LEN..FIXED_LEN + layout_len];
-    let record_size = u32_at(b, 16);
+    };
+    let record_size = u32_at(b, 16)?;
     if layout != RECORD_LAYOUT.as_bytes() || record_size != RECORD_SIZE {
         return Err(Problem::Layout {
             found: String::from_utf8_lossy(layout).into_owned(),
             size: record_size,
         });
     }
-    let params = &b[FIXED_LEN + layout_len..FIXED_LEN + layout_len + params_len];
     let params = String::from_utf8(params.to_vec())
         .map_err(|_| corrupt("emission parameters are not UTF-8"))?;
-    let kind = match b[68] {
+    let [kind, reserved] = field(b, 68)?;
+    let kind = match kind {
         1 => MapKind::Global,
         2 => MapKind::Caustic,
         k => return Err(Problem::Corrupt(format!("unknown map kind {k}"))),
     };
-    if b[69] != 0
-        || b[FIXED_LEN + layout_len + params_len..n - 4]
-            .iter()
-            .any(|&x| x != 0)
-    {
+    if reserved != 0 || padding.iter().any(|&x| x != 0) {
         return Err(corrupt("non-zero reserved header bytes"));
     }
-    let capacity = u32_at(b, 20);
+    let capacity = u32_at(b, 20)?;
     if capacity == 0 || capacity > MAX_CHUNK_PHOTONS {
         return Err(Problem::Corrupt(format!(
             "impossible chunk capacity {capacity}"
         )));
     }
-    let stored = u64_at(b, 24);
-    let count = u32_at(b, 64);
+    let stored = u64_at(b, 24)?;
+    let count = u32_at(b, 64)?;
     if stored.div_ceil(capacity.into()) != count.into() {
         return Err(Problem::Corrupt(format!(
             "{stored} photons cannot fill {count} chunks of {capacity}"
@@ -280,11 +318,11 @@ pub fn decode_header(b: &[u8]) -> Result<(Header, Chunks), Problem> {
     }
     let header = Header {
         kind,
-        seed: u64_at(b, 40),
-        scene_hash: u64_at(b, 48),
-        params_hash: u64_at(b, 56),
+        seed: u64_at(b, 40)?,
+        scene_hash: u64_at(b, 48)?,
+        params_hash: u64_at(b, 56)?,
         params,
-        emitted: u64_at(b, 32),
+        emitted: u64_at(b, 32)?,
         stored,
     };
     let chunks = Chunks {
@@ -297,7 +335,12 @@ pub fn decode_header(b: &[u8]) -> Result<(Header, Chunks), Problem> {
 }
 
 /// Fills the chunk header `head` for a chunk whose payload is `payload`.
-pub fn encode_chunk_header(head: &mut [u8], index: u32, first: u64, payload: &[u8]) {
+pub fn encode_chunk_header(
+    head: &mut [u8; CHUNK_HEADER_LEN],
+    index: u32,
+    first: u64,
+    payload: &[u8],
+) {
     head[0..8].copy_from_slice(&CHUNK_TAG);
     head[8..12].copy_from_slice(&index.to_le_bytes());
     head[12..16].copy_from_slice(&((payload.len() / 32) as u32).to_le_bytes());
@@ -311,11 +354,16 @@ pub fn encode_chunk_header(head: &mut [u8], index: u32, first: u64, payload: &[u
 
 /// Verifies chunk `i` of `chunks` given its header bytes and its payload (whose length the file
 /// header fixes, so a corrupt count cannot make us read the wrong bytes).
-pub fn check_chunk(head: &[u8], payload: &[u8], i: u32, chunks: &Chunks) -> Result<(), Problem> {
+pub fn check_chunk(
+    head: &[u8; CHUNK_HEADER_LEN],
+    payload: &[u8],
+    i: u32,
+    chunks: &Chunks,
+) -> Result<(), Problem> {
     let mut crc = crc32fast::Hasher::new();
     crc.update(&head[..28]);
     crc.update(payload);
-    if crc.finalize() != u32_at(head, 28) {
+    if crc.finalize() != u32_at(head, 28)? {
         return Err(Problem::ChunkChecksum {
             chunk: i,
             of: chunks.count,
@@ -323,10 +371,10 @@ pub fn check_chunk(head: &[u8], payload: &[u8], i: u32, chunks: &Chunks) -> Resu
     }
     let first = u64::from(i) * u64::from(chunks.capacity);
     let consistent = head[0..8] == CHUNK_TAG
-        && u32_at(head, 8) == i
-        && u32_at(head, 12) == chunks.photons_in(i)
-        && u64_at(head, 16) == first
-        && u32_at(head, 24) == 0;
+        && u32_at(head, 8)? == i
+        && u32_at(head, 12)? == chunks.photons_in(i)
+        && u64_at(head, 16)? == first
+        && u32_at(head, 24)? == 0;
     if !consistent {
         return Err(Problem::Corrupt(format!(
             "chunk {} of {} has a header that disagrees with the file header",

@@ -1,3 +1,17 @@
+// A decoder of untrusted bytes: no input may reach a panic, so the lints that find the ways
+// to one (unwrap, expect, indexing, explicit panics) are errors here; `cargo clippy` is the
+// check.
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::indexing_slicing,
+        clippy::panic,
+        clippy::unreachable
+    )
+)]
+
 use bytemuck::Zeroable;
 use std::fs::File;
 use std::io::{ErrorKind, Read};
@@ -22,7 +36,19 @@ fn read_header(path: &Path, file: &mut File) -> Result<(Header, Chunks), StoreEr
     let header_len = decode_prefix(&prefix, len).map_err(|p| StoreError::new(path, p))?;
     let mut block = prefix;
     block.resize(header_len as usize, 0);
-    file.read_exact(&mut block[PREFIX_LEN..])
+    // `decode_prefix` read PREFIX_LEN bytes and admits no shorter header.
+    let Some(rest) = block.get_mut(PREFIX_LEN..) else {
+        let end = PREFIX_LEN as u64;
+        return Err(StoreError::new(
+            path,
+            Problem::Truncated {
+                chunk: None,
+                end,
+                len,
+            },
+        ));
+    };
+    file.read_exact(rest)
         .map_err(|e| StoreError::io(path, "read", e))?;
     let (header, chunks) = decode_header(&block).map_err(|p| StoreError::new(path, p))?;
     chunks
@@ -165,17 +191,30 @@ impl MappedStore {
             .map_err(|e| StoreError::io(path, "map", e))?;
         let err = |p| StoreError::new(path, p);
         let bytes: &[u8] = &map;
-        let header_len = decode_prefix(&bytes[..PREFIX_LEN.min(bytes.len())], len).map_err(err)?;
-        let (header, chunks) = decode_header(&bytes[..header_len as usize]).map_err(err)?;
+        let prefix = bytes.get(..PREFIX_LEN).unwrap_or(bytes);
+        let header_len = decode_prefix(prefix, len).map_err(err)?;
+        // `decode_prefix` checked the header against the file's length.
+        let truncated = |chunk, end| err(Problem::Truncated { chunk, end, len });
+        let block = bytes
+            .get(..header_len as usize)
+            .ok_or_else(|| truncated(None, header_len))?;
+        let (header, chunks) = decode_header(block).map_err(err)?;
         chunks.check_len(len).map_err(err)?;
         let mut payloads = Vec::with_capacity(chunks.count as usize);
         for i in 0..chunks.count {
             let at = chunks.offset(i) as usize;
             let body = at + CHUNK_HEADER_LEN..chunks.end(i) as usize;
-            check_chunk(&bytes[at..body.start], &bytes[body.clone()], i, &chunks).map_err(err)?;
+            // `check_len` checked every chunk against the file's length.
+            let (Some(head), Some(payload)) = (
+                bytes.get(at..body.start).and_then(|h| h.try_into().ok()),
+                bytes.get(body.clone()),
+            ) else {
+                return Err(truncated(Some((i, chunks.count)), chunks.end(i)));
+            };
+            check_chunk(head, payload, i, &chunks).map_err(err)?;
             // Offsets are multiples of 32 and the map is page-aligned; checked once here so
             // `chunks` can cast without failing.
-            bytemuck::try_cast_slice::<u8, Photon>(&bytes[body.clone()])
+            bytemuck::try_cast_slice::<u8, Photon>(payload)
                 .map_err(|e| err(Problem::Corrupt(format!("chunk {} misaligned: {e}", i + 1))))?;
             payloads.push(body);
         }
@@ -202,9 +241,14 @@ impl MappedStore {
 
     /// The photons, one verified chunk at a time, in file order.
     pub fn chunks(&self) -> impl Iterator<Item = &[Photon]> + '_ {
-        self.payloads
-            .iter()
-            .map(|r| bytemuck::cast_slice(&self.map[r.clone()]))
+        // `open` checked every range against this map and its cast, so the fallback (an
+        // empty chunk) is never taken: it stands where a panic would otherwise be.
+        self.payloads.iter().map(|r| {
+            self.map
+                .get(r.clone())
+                .and_then(|b| bytemuck::try_cast_slice(b).ok())
+                .unwrap_or_default()
+        })
     }
 
     pub fn to_vec(&self) -> Vec<Photon> {
