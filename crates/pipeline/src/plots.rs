@@ -47,6 +47,13 @@ fn log_range(v: impl Iterator<Item = f64>) -> Option<std::ops::Range<f64>> {
     (hi > 0.0).then(|| lo / 1.5..hi * 1.5)
 }
 
+/// The log range `r` extended upwards so that a legend of `lines` lines (about 17 pixels
+/// each on a 560-pixel plot) sits above the data instead of over it.
+fn above_for_legend(r: std::ops::Range<f64>, lines: usize) -> std::ops::Range<f64> {
+    let share = ((lines as f64 * 17.0 + 20.0) / 470.0).min(0.7);
+    r.start..r.end * (r.end / r.start).powf(share / (1.0 - share))
+}
+
 /// Log-log lines of `series`, with dashed reference lines of the given `slopes` (each
 /// through the middle of the data) and a legend. Points that are not positive are left out.
 pub fn log_log(
@@ -65,7 +72,9 @@ pub fn log_log(
     ) else {
         return Err(e("no positive point".into()));
     };
-    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    let data_y = yr.clone();
+    let yr = above_for_legend(yr, series.len() + slopes.len());
+    let root = SVGBackend::new(path, (900, 640)).into_drawing_area();
     root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 22))
@@ -91,7 +100,10 @@ pub fn log_log(
         .draw()
         .map_err(|x| e(x.to_string()))?;
     // Reference slopes through the geometric centre of the data, clipped to the plot.
-    let (cx, cy) = ((xr.start * xr.end).sqrt(), (yr.start * yr.end).sqrt());
+    let (cx, cy) = (
+        (xr.start * xr.end).sqrt(),
+        (data_y.start * data_y.end).sqrt(),
+    );
     for (i, &(slope, label)) in slopes.iter().enumerate() {
         let x_at = |y: f64| cx * (y / cy).powf(1.0 / slope);
         let (xa, xb) = (x_at(yr.end), x_at(yr.start));
@@ -148,7 +160,8 @@ pub fn bias_variance_k(path: &Path, title: &str, series: &[KSeries]) -> Result<(
     ) else {
         return Err(e("no positive point".into()));
     };
-    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    let yr = above_for_legend(yr, series.len());
+    let root = SVGBackend::new(path, (900, 640)).into_drawing_area();
     root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 22))
@@ -194,7 +207,7 @@ pub fn bias_variance_k(path: &Path, title: &str, series: &[KSeries]) -> Result<(
     }
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
+        .position(SeriesLabelPosition::UpperRight)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font(("sans-serif", 13))

@@ -238,10 +238,10 @@ fn flags(t: &crate::evidence::Technique, amount: u64) -> String {
     }
     let mut s = f.join(" ");
     if let Some(n) = o.splat_photons {
-        let _ = write!(s, ", scene file `[estimate.splat] photons = {n}`");
+        let _ = write!(s, ", and in the scene file [estimate.splat] photons = {n}");
     }
     if o.splat_indirect == Some(false) {
-        s.push_str(", `indirect = false`");
+        s.push_str(", indirect = false");
     }
     s
 }
