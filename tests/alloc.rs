@@ -2,8 +2,8 @@
 //! last asked: the fuzz loops' check that no allocation is sized by an unchecked header
 //! field. It forwards everything to the system allocator.
 
-// The one unsafe code of the workspace: `GlobalAlloc` is an unsafe trait, and these forward
-// to `System` with the caller's own layout and pointer.
+// Unsafe code (with the photon file's memory map, the only in the workspace): `GlobalAlloc`
+// is an unsafe trait, and these forward to `System` with the caller's own layout and pointer.
 #![allow(unsafe_code)]
 
 use std::alloc::{GlobalAlloc, Layout, System};
