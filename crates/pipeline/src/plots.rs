@@ -54,6 +54,42 @@ fn above_for_legend(r: std::ops::Range<f64>, lines: usize) -> std::ops::Range<f6
     r.start..r.end * (r.end / r.start).powf(share / (1.0 - share))
 }
 
+type LogChart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+
+/// A white log-log chart over `root` with its title, grid and axis descriptions.
+fn log_chart<'a, 'b>(
+    root: &'a DrawingArea<SVGBackend<'b>, Shift>,
+    title: &str,
+    (xr, yr): (std::ops::Range<f64>, std::ops::Range<f64>),
+    (x_desc, y_desc): (&str, &str),
+) -> Result<LogChart<'a, 'b>, String> {
+    root.fill(&WHITE).map_err(|x| x.to_string())?;
+    // Within one decade a log axis only has labels between the powers of ten.
+    let decades = yr.end / yr.start > 10.0;
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(70)
+        .build_cartesian_2d(xr.log_scale(), yr.log_scale())
+        .map_err(|x| x.to_string())?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .y_label_formatter(&|v| {
+            if decades {
+                format!("{v:.0e}")
+            } else {
+                format!("{v:.3}")
+            }
+        })
+        .x_label_formatter(&|v| format!("{v}"))
+        .draw()
+        .map_err(|x| x.to_string())?;
+    Ok(chart)
+}
+
 /// Log-log lines of `series`, with dashed reference lines of the given `slopes` (each
 /// through the middle of the data) and a legend. Points that are not positive are left out.
 pub fn log_log(
@@ -75,30 +111,8 @@ pub fn log_log(
     let data_y = yr.clone();
     let yr = above_for_legend(yr, series.len() + slopes.len());
     let root = SVGBackend::new(path, (900, 640)).into_drawing_area();
-    root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size(70)
-        .build_cartesian_2d(xr.clone().log_scale(), yr.clone().log_scale())
-        .map_err(|x| e(x.to_string()))?;
-    // Within one decade a log axis only has labels between the powers of ten.
-    let decades = yr.end / yr.start > 10.0;
-    chart
-        .configure_mesh()
-        .x_desc(x_desc)
-        .y_desc(y_desc)
-        .y_label_formatter(&|v| {
-            if decades {
-                format!("{v:.0e}")
-            } else {
-                format!("{v:.3}")
-            }
-        })
-        .x_label_formatter(&|v| format!("{v}"))
-        .draw()
-        .map_err(|x| e(x.to_string()))?;
+    let mut chart =
+        log_chart(&root, title, (xr.clone(), yr.clone()), (x_desc, y_desc)).map_err(&e)?;
     // Reference slopes through the geometric centre of the data, clipped to the plot.
     let (cx, cy) = (
         (xr.start * xr.end).sqrt(),
@@ -162,22 +176,11 @@ pub fn bias_variance_k(path: &Path, title: &str, series: &[KSeries]) -> Result<(
     };
     let yr = above_for_legend(yr, series.len());
     let root = SVGBackend::new(path, (900, 640)).into_drawing_area();
-    root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size(70)
-        .build_cartesian_2d(xr.log_scale(), yr.log_scale())
-        .map_err(|x| e(x.to_string()))?;
-    chart
-        .configure_mesh()
-        .x_desc("k (photons per estimate)")
-        .y_desc("relative bias^2 (solid), variance (dashed)")
-        .y_label_formatter(&|v| format!("{v:.0e}"))
-        .x_label_formatter(&|v| format!("{v}"))
-        .draw()
-        .map_err(|x| e(x.to_string()))?;
+    let axes = (
+        "k (photons per estimate)",
+        "relative bias^2 (solid), variance (dashed)",
+    );
+    let mut chart = log_chart(&root, title, (xr, yr), axes).map_err(&e)?;
     for (i, (name, pts)) in series.iter().enumerate() {
         let c = colour(i);
         let bias: Vec<(f64, f64)> = pts
