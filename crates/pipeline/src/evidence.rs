@@ -157,8 +157,6 @@ pub fn techniques(quick: bool) -> Vec<Technique> {
             overrides: Overrides {
                 method: Some(Method::FinalGather),
                 gather_rays: Some(0),
-                // No gather rays read the irradiance cache: do not pay for building it.
-                gather_cache: Some(0),
                 ..Overrides::default()
             },
             budget: Budget::Photons,

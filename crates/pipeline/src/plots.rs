@@ -90,6 +90,22 @@ fn log_chart<'a, 'b>(
     Ok(chart)
 }
 
+/// The legend (above the data: see [`above_for_legend`]), then the file written.
+fn finish<'a, 'b>(
+    mut chart: LogChart<'a, 'b>,
+    root: &'a DrawingArea<SVGBackend<'b>, Shift>,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(|x| x.to_string())?;
+    root.present().map_err(|x| x.to_string())
+}
+
 /// Log-log lines of `series`, with dashed reference lines of the given `slopes` (each
 /// through the middle of the data) and a legend. Points that are not positive are left out.
 pub fn log_log(
@@ -153,15 +169,7 @@ pub fn log_log(
             .draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled())))
             .map_err(|x| e(x.to_string()))?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(|x| e(x.to_string()))?;
-    root.present().map_err(|x| e(x.to_string()))
+    finish(chart, &root).map_err(e)
 }
 
 /// Bias² (solid) and variance (dashed) against k, one colour per kernel variant, log-log.
@@ -208,15 +216,7 @@ pub fn bias_variance_k(path: &Path, title: &str, series: &[KSeries]) -> Result<(
             .draw_series(var.iter().map(|&p| Circle::new(p, 3, c.stroke_width(1))))
             .map_err(|x| e(x.to_string()))?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(|x| e(x.to_string()))?;
-    root.present().map_err(|x| e(x.to_string()))
+    finish(chart, &root).map_err(e)
 }
 
 /// One panel per region: a bar per technique, bias² (dark) stacked under variance (light),

@@ -12,7 +12,8 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     let fg = run.settings.estimate.final_gather;
     let spp = run.settings.estimate.spp;
     let t_cache = std::time::Instant::now();
-    if fg.cache > 0 {
+    // Without gather rays nothing reads the cache: do not build it.
+    if fg.cache > 0 && fg.rays > 0 {
         // The cache stores exactly what a direct lookup would answer at its points, boundary
         // correction included.
         let maps = &inputs.maps;
@@ -44,7 +45,7 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     info.insert("gather_rays".into(), fg.rays.into());
     info.insert(
         "gather_cache_stride".into(),
-        (fg.cache > 0).then_some(fg.cache).into(),
+        (fg.cache > 0 && fg.rays > 0).then_some(fg.cache).into(),
     );
     info.insert("time_gather_cache_s".into(), t_cache.into());
     info.insert("time_render_s".into(), seconds.into());
