@@ -176,7 +176,7 @@ impl Default for RenderSettings {
         RenderSettings {
             spp: 16,
             max_depth: 64,
-            rr_depth: 3,
+            rr_depth: 5,
             tile: 16,
             method: Method::FinalGather,
             caustics: true,
