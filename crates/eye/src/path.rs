@@ -4,7 +4,7 @@
 use bsdf::TransportMode;
 use geom::Ray;
 use glam::Vec3;
-use math::{Frame, Rng, power_heuristic};
+use math::{Frame, Sampler, power_heuristic};
 use scene::{Scene, sides_agree};
 
 /// Which family of light paths a contribution belongs to (Heckbert's notation, read from the
@@ -140,10 +140,10 @@ impl<'a> PathTracer<'a> {
     }
 
     /// Radiance arriving along `-ray.d` at `ray.o`, estimated by one path whose random
-    /// numbers all come from `rng`. Every vertex draws the same seven uniforms whatever
+    /// numbers all come from `rng` (independent or low-discrepancy: see [`Sampler`]). Every vertex draws the same seven uniforms whatever
     /// happens there, so options that only drop contributions (caustics) never shift the
     /// stream.
-    pub fn li(&self, ray: Ray, rng: &mut Rng) -> Radiance {
+    pub fn li<S: Sampler>(&self, ray: Ray, rng: &mut S) -> Radiance {
         let geometry = &self.scene.geometry;
         let lights = &self.scene.light_table;
         let mut out = Radiance::default();

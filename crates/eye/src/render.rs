@@ -2,7 +2,7 @@
 
 use crate::{Part, PathOptions, PathTracer};
 use film::{Film, TileBuffer, tiles};
-use math::Rng;
+use math::{Rng, Sampler, SobolSampler, mix64};
 use rayon::prelude::*;
 use scene::Scene;
 
@@ -65,21 +65,57 @@ pub fn render(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) + Syn
         },
     );
     let names = Part::ALL.map(Part::name);
-    render_layers(scene, opts, names, progress, &|ray, rng| {
-        let l = tracer.li(ray, rng);
-        Part::ALL.map(|p| l.get(p))
-    })
+    match scene.render().sampler {
+        scene::SamplerKind::Sobol => render_layers(
+            scene,
+            opts,
+            names,
+            progress,
+            &|ray, s: &mut SobolSampler| {
+                let l = tracer.li(ray, s);
+                Part::ALL.map(|p| l.get(p))
+            },
+        ),
+        scene::SamplerKind::Independent => {
+            render_layers(scene, opts, names, progress, &|ray, rng: &mut Rng| {
+                let l = tracer.li(ray, rng);
+                Part::ALL.map(|p| l.get(p))
+            })
+        }
+    }
+}
+
+/// How the tile loop makes the sampler of pixel sample `s` of pixel `p` (of `pixels`).
+pub(crate) trait PixelSampler: Sampler + Sized {
+    fn for_pixel_sample(seed: u64, pixels: u64, pixel: u64, s: u64) -> Self;
+}
+
+impl PixelSampler for Rng {
+    /// Stream `s * pixels + p`: sample-major, so a pass of samples draws what the same
+    /// samples of a longer run draw.
+    fn for_pixel_sample(seed: u64, pixels: u64, pixel: u64, s: u64) -> Rng {
+        Rng::for_index(seed, s * pixels + pixel)
+    }
+}
+
+impl PixelSampler for SobolSampler {
+    /// Sample `s` of the pixel's own scrambled sequence (indices past 2^32 wrap: the
+    /// sequence repeats only after four billion samples of one pixel).
+    fn for_pixel_sample(seed: u64, _pixels: u64, pixel: u64, s: u64) -> SobolSampler {
+        SobolSampler::new(mix64(seed ^ mix64(pixel ^ 0x736f_626f_6c00)), s as u32)
+    }
 }
 
 /// The tile machinery shared by every eye-pass method: one film layer per entry of `names`,
-/// pixel sample `s` of pixel `p` drawing from `Rng::for_index(seed, s * pixels + p)` (after two
-/// numbers for the pixel jitter), `sample` returning one contribution per layer.
-pub(crate) fn render_layers<const N: usize>(
+/// pixel sample `s` of pixel `p` drawing from the sampler [`PixelSampler::for_pixel_sample`]
+/// makes (after two numbers for the pixel jitter), `sample` returning one contribution per
+/// layer.
+pub(crate) fn render_layers<const N: usize, S: PixelSampler>(
     scene: &Scene,
     opts: &RenderOptions,
     names: [&str; N],
     progress: &(dyn Fn(u64) + Sync),
-    sample: &(dyn Fn(geom::Ray, &mut Rng) -> [glam::Vec3; N] + Sync),
+    sample: &(dyn Fn(geom::Ray, &mut S) -> [glam::Vec3; N] + Sync),
 ) -> Film {
     assert!(opts.spp > 0, "render: spp must be positive");
     assert!(opts.tile > 0, "render: tile must be positive");
@@ -109,13 +145,13 @@ pub(crate) fn render_layers<const N: usize>(
     film
 }
 
-fn render_tile<const N: usize>(
+fn render_tile<const N: usize, S: PixelSampler>(
     scene: &Scene,
     film: &Film,
     rect: film::Rect,
     opts: &RenderOptions,
     names: [&str; N],
-    sample: &(dyn Fn(geom::Ray, &mut Rng) -> [glam::Vec3; N] + Sync),
+    sample: &(dyn Fn(geom::Ray, &mut S) -> [glam::Vec3; N] + Sync),
 ) -> TileBuffer {
     let seed = scene.seed();
     let width = film.width();
@@ -129,7 +165,7 @@ fn render_tile<const N: usize>(
             let pixel = (y * width + x) as u64;
             let mut sums = [glam::DVec3::ZERO; N];
             for s in first..first + spp {
-                let mut rng = Rng::for_index(seed, s * pixels + pixel);
+                let mut rng = S::for_pixel_sample(seed, pixels, pixel, s);
                 let [jx, jy] = rng.uniform2();
                 let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
                 let l = sample(ray, &mut rng);

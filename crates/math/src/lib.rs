@@ -11,10 +11,12 @@ pub mod analytic;
 pub mod chi2;
 mod frame;
 mod rng;
+pub mod sampler;
 pub mod warp;
 
 pub use frame::Frame;
 pub use rng::{Rng, mix64};
+pub use sampler::{Sampler, SobolSampler};
 pub use warp::{Distribution1D, power_heuristic};
 
 #[cfg(test)]

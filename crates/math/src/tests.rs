@@ -3,6 +3,7 @@ use crate::Rng;
 // The warp, frame and chi-square tests live in tests/ (one file per module).
 mod chi2;
 mod frame;
+mod sampler;
 mod warp;
 
 #[test]

@@ -23,7 +23,7 @@ pub use camera::Camera;
 pub use error::SceneError;
 pub use file::{
     CameraDesc, EmissionSource, MaterialDesc, MeshDesc, Method, NormalMode, RenderSettings,
-    SceneFile, SphereDesc,
+    SamplerKind, SceneFile, SphereDesc,
 };
 pub use lights::{Emitted, LightPoint, LightSample, LightTable};
 pub use load::{AreaLight, Scene, fnv1a64};

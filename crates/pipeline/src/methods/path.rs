@@ -100,6 +100,10 @@ impl<'a> Progressive<'a> {
             ("caustic_indirect", self.opts.caustic_indirect.into()),
             ("max_depth", r.max_depth.into()),
             ("rr_depth", r.rr_depth.into()),
+            (
+                "sampler",
+                serde_json::to_value(r.sampler).unwrap_or_default(),
+            ),
             ("samples", samples.into()),
             ("path_passes", passes.into()),
             ("time_render_s", seconds.into()),

@@ -1,0 +1,137 @@
+//! Samplers: where a pixel sample's uniforms come from.
+//!
+//! [`Sampler`] is the one interface the path loop draws through. [`Rng`] is the independent
+//! sampler; [`SobolSampler`] is the low-discrepancy one: a *padded*, Owen-scrambled 2-D Sobol
+//! sequence (Burley 2020, "Practical Hash-based Owen Scrambling", JCGT 9(4), §4-5; the
+//! sampler pbrt-v4 calls `PaddedSobolSampler`, §8.7.5). Its value for (pixel, sample index,
+//! dimension) is a pure function, so images stay bit-identical for any thread count and any
+//! split of samples over passes.
+//!
+//! Why padded 2-D rather than one high-dimensional Sobol point: every pair of dimensions (the
+//! pixel jitter, the light sample at bounce 3, the BSDF direction at bounce 1, ...) gets the
+//! best 2-D stratification there is (a (0,2)-sequence), and pairs are decorrelated from each
+//! other by their own random shuffle of the sample index, with no generator matrices to
+//! run out of.
+
+use crate::{Rng, mix64};
+
+/// A source of uniforms in [0, 1) for one pixel sample (or one photon path).
+pub trait Sampler {
+    fn uniform(&mut self) -> f32;
+    fn uniform2(&mut self) -> [f32; 2];
+}
+
+impl Sampler for Rng {
+    #[inline]
+    fn uniform(&mut self) -> f32 {
+        Rng::uniform(self)
+    }
+    #[inline]
+    fn uniform2(&mut self) -> [f32; 2] {
+        Rng::uniform2(self)
+    }
+}
+
+/// Sample `index` of the Owen-scrambled, index-shuffled 2-D Sobol sequence of one pixel.
+/// Dimension `d` (counting one per call of `uniform` or `uniform2`) has its own scramble
+/// seeds, derived from the pixel's seed and `d` by a hash.
+#[derive(Clone, Debug)]
+pub struct SobolSampler {
+    seed: u64,
+    index: u32,
+    dim: u32,
+}
+
+impl SobolSampler {
+    /// Sample `index` of the sequence identified by `seed` (the caller mixes the run's seed
+    /// and the pixel into it).
+    pub fn new(seed: u64, index: u32) -> SobolSampler {
+        SobolSampler {
+            seed,
+            index,
+            dim: 0,
+        }
+    }
+
+    /// Three 32-bit hashes for dimension `d`: the index shuffle and the two scrambles.
+    #[inline]
+    fn seeds(&self, d: u32) -> (u32, u32, u32) {
+        let h = mix64(self.seed ^ mix64(d as u64 ^ 0x5eed_0000_0000));
+        let h2 = mix64(h);
+        (h as u32, (h >> 32) as u32, h2 as u32)
+    }
+
+    #[inline]
+    fn point(&mut self) -> [u32; 2] {
+        let (shuffle, s0, s1) = self.seeds(self.dim);
+        self.dim += 1;
+        // Shuffling the index by a nested uniform scramble permutes the points of every
+        // power-of-two prefix among themselves, so any 2^m samples stay a (0,m,2)-net while
+        // different dimensions see the points in unrelated orders (Burley 2020, §4).
+        let i = nested_uniform_scramble(self.index, shuffle);
+        [
+            nested_uniform_scramble(sobol0(i), s0),
+            nested_uniform_scramble(sobol1(i), s1),
+        ]
+    }
+}
+
+impl Sampler for SobolSampler {
+    #[inline]
+    fn uniform(&mut self) -> f32 {
+        to_unit(self.point()[0])
+    }
+    #[inline]
+    fn uniform2(&mut self) -> [f32; 2] {
+        let [a, b] = self.point();
+        [to_unit(a), to_unit(b)]
+    }
+}
+
+/// The top 24 bits as a float in [0, 1) (never rounds up to 1).
+#[inline]
+fn to_unit(x: u32) -> f32 {
+    (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+}
+
+/// First Sobol dimension: the van der Corput radical inverse in base 2.
+#[inline]
+pub fn sobol0(i: u32) -> u32 {
+    i.reverse_bits()
+}
+
+/// Second Sobol dimension: generator matrix from the primitive polynomial x + 1, whose
+/// direction numbers satisfy v_k = v_{k-1} xor (v_{k-1} >> 1) (Joe and Kuo 2008, dimension 2).
+/// Together with [`sobol0`] it makes a (0,2)-sequence in base 2.
+#[inline]
+pub fn sobol1(mut i: u32) -> u32 {
+    let mut v = 1u32 << 31;
+    let mut x = 0;
+    while i != 0 {
+        if i & 1 != 0 {
+            x ^= v;
+        }
+        i >>= 1;
+        v ^= v >> 1;
+    }
+    x
+}
+
+/// A hash that permutes bits only downwards (each output bit depends on itself and lower
+/// bits): Laine and Karras 2011's construction with Burley 2020's constants (his Listing 4).
+#[inline]
+fn laine_karras(mut x: u32, seed: u32) -> u32 {
+    x = x.wrapping_add(seed);
+    x ^= x.wrapping_mul(0x6c50_b47c);
+    x ^= x.wrapping_mul(0xb82f_1e52);
+    x ^= x.wrapping_mul(0xc7af_e638);
+    x ^= x.wrapping_mul(0x8d22_f6e6);
+    x
+}
+
+/// Owen scrambling in base 2 as a hash: reversed, each bit flipped by a function of the bits
+/// above it in the original order (Burley 2020, Listing 3).
+#[inline]
+pub fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
+    laine_karras(x.reverse_bits(), seed).reverse_bits()
+}
