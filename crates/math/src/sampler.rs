@@ -38,7 +38,8 @@ impl Sampler for Rng {
 #[derive(Clone, Debug)]
 pub struct SobolSampler {
     seed: u64,
-    index: u32,
+    /// The sample index, bit-reversed once (every dimension's shuffle starts from it).
+    rindex: u32,
     dim: u32,
 }
 
@@ -48,43 +49,55 @@ impl SobolSampler {
     pub fn new(seed: u64, index: u32) -> SobolSampler {
         SobolSampler {
             seed,
-            index,
+            rindex: index.reverse_bits(),
             dim: 0,
         }
     }
 
-    /// Three 32-bit hashes for dimension `d`: the index shuffle and the two scrambles.
+    /// 64 bits of hash for dimension `d`: SplitMix64 of the sequence's seed stepped by `d`
+    /// (Steele et al. 2014), one mix per dimension.
     #[inline]
-    fn seeds(&self, d: u32) -> (u32, u32, u32) {
-        let h = mix64(self.seed ^ mix64(d as u64 ^ 0x5eed_0000_0000));
-        let h2 = mix64(h);
-        (h as u32, (h >> 32) as u32, h2 as u32)
+    fn hash(&mut self) -> u64 {
+        let d = self.dim as u64;
+        self.dim += 1;
+        mix64(
+            self.seed
+                .wrapping_add(d.wrapping_mul(0x9e37_79b9_7f4a_7c15)),
+        )
     }
 
+    /// The sample index as dimension `h` sees it, *bit-reversed* (which is also its first
+    /// Sobol coordinate, [`sobol0`]). Shuffling the index by a nested uniform scramble
+    /// permutes the points of every power-of-two block among themselves (up to a digital
+    /// shift), so any 2^m samples stay a (0,m,2)-net while different dimensions see the
+    /// points in unrelated orders (Burley 2020, §4). `nested_uniform_scramble(index, s)`
+    /// reversed is `laine_karras(reversed index, s)`: no reversal needed here.
     #[inline]
-    fn point(&mut self) -> [u32; 2] {
-        let (shuffle, s0, s1) = self.seeds(self.dim);
-        self.dim += 1;
-        // Shuffling the index by a nested uniform scramble permutes the points of every
-        // power-of-two prefix among themselves, so any 2^m samples stay a (0,m,2)-net while
-        // different dimensions see the points in unrelated orders (Burley 2020, §4).
-        let i = nested_uniform_scramble(self.index, shuffle);
-        [
-            nested_uniform_scramble(sobol0(i), s0),
-            nested_uniform_scramble(sobol1(i), s1),
-        ]
+    fn shuffled_reversed(&self, h: u64) -> u32 {
+        laine_karras(
+            self.rindex,
+            (h.wrapping_mul(0xd6e8_feb8_6659_fd93) >> 32) as u32,
+        )
     }
 }
 
 impl Sampler for SobolSampler {
     #[inline]
     fn uniform(&mut self) -> f32 {
-        to_unit(self.point()[0])
+        let h = self.hash();
+        let x0 = self.shuffled_reversed(h);
+        // nested_uniform_scramble(x0, s) with x0 = sobol0(i) = reverse(i).
+        to_unit(laine_karras(x0.reverse_bits(), h as u32).reverse_bits())
     }
     #[inline]
     fn uniform2(&mut self) -> [f32; 2] {
-        let [a, b] = self.point();
-        [to_unit(a), to_unit(b)]
+        let h = self.hash();
+        let x0 = self.shuffled_reversed(h);
+        let i = x0.reverse_bits();
+        [
+            to_unit(laine_karras(i, h as u32).reverse_bits()),
+            to_unit(nested_uniform_scramble(sobol1(i), (h >> 32) as u32)),
+        ]
     }
 }
 
@@ -103,8 +116,53 @@ pub fn sobol0(i: u32) -> u32 {
 /// Second Sobol dimension: generator matrix from the primitive polynomial x + 1, whose
 /// direction numbers satisfy v_k = v_{k-1} xor (v_{k-1} >> 1) (Joe and Kuo 2008, dimension 2).
 /// Together with [`sobol0`] it makes a (0,2)-sequence in base 2.
+/// The matrix is linear over GF(2), so the product is the xor of one table entry per byte of
+/// the index: four lookups instead of a loop over 32 bits.
 #[inline]
-pub fn sobol1(mut i: u32) -> u32 {
+pub fn sobol1(i: u32) -> u32 {
+    let t = &SOBOL1_BYTES;
+    t[0][(i & 0xff) as usize]
+        ^ t[1][((i >> 8) & 0xff) as usize]
+        ^ t[2][((i >> 16) & 0xff) as usize]
+        ^ t[3][(i >> 24) as usize]
+}
+
+/// `SOBOL1_BYTES[b][x]`: xor of the direction numbers of the set bits of `x << 8b`.
+static SOBOL1_BYTES: [[u32; 256]; 4] = sobol1_tables();
+
+const fn sobol1_tables() -> [[u32; 256]; 4] {
+    let mut dirs = [0u32; 32];
+    let mut v = 1u32 << 31;
+    let mut k = 0;
+    while k < 32 {
+        dirs[k] = v;
+        v ^= v >> 1;
+        k += 1;
+    }
+    let mut t = [[0u32; 256]; 4];
+    let mut b = 0;
+    while b < 4 {
+        let mut x = 0;
+        while x < 256 {
+            let mut acc = 0;
+            let mut bit = 0;
+            while bit < 8 {
+                if x & (1 << bit) != 0 {
+                    acc ^= dirs[8 * b + bit];
+                }
+                bit += 1;
+            }
+            t[b][x] = acc;
+            x += 1;
+        }
+        b += 1;
+    }
+    t
+}
+
+/// The bit loop [`sobol1`]'s tables are built from, kept for the test that checks them.
+#[cfg(test)]
+pub fn sobol1_by_bits(mut i: u32) -> u32 {
     let mut v = 1u32 << 31;
     let mut x = 0;
     while i != 0 {

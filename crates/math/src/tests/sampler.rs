@@ -1,4 +1,4 @@
-use crate::sampler::{nested_uniform_scramble, sobol0, sobol1};
+use crate::sampler::{nested_uniform_scramble, sobol0, sobol1, sobol1_by_bits};
 use crate::{Rng, Sampler, SobolSampler};
 
 /// Whether points (in 32-bit fixed point) form a (0,m,2)-net: every elementary interval of
@@ -109,4 +109,41 @@ fn a_smooth_integral_converges_faster_than_with_independent_samples() {
         "sobol {e_sobol}, independent {e_indep}"
     );
     // And it stays unbiased: the mean over pixels is within a few standard errors.
+}
+
+#[test]
+fn the_byte_tables_compute_the_same_matrix_product_as_the_bit_loop() {
+    let mut rng = Rng::new(8);
+    for i in (0..4096)
+        .chain((0..10_000).map(|_| rng.next_u32()))
+        .chain([u32::MAX])
+    {
+        assert_eq!(sobol1(i), sobol1_by_bits(i), "index {i}");
+    }
+}
+
+/// The sampler's shortcuts (reversals cancelled) compute exactly the textbook composition:
+/// shuffle the index, take the Sobol coordinates, Owen-scramble each.
+#[test]
+fn the_sampler_is_the_scrambled_shuffled_sobol_point() {
+    use crate::mix64;
+    let seed = 0x1234_5678_9abc_def0u64;
+    for index in [0u32, 1, 2, 3, 77, 1 << 20, u32::MAX] {
+        let mut s = SobolSampler::new(seed, index);
+        for d in 0..6u64 {
+            let h = mix64(seed.wrapping_add(d.wrapping_mul(0x9e37_79b9_7f4a_7c15)));
+            let i = nested_uniform_scramble(
+                index,
+                (h.wrapping_mul(0xd6e8_feb8_6659_fd93) >> 32) as u32,
+            );
+            let unit = |x: u32| (x >> 8) as f32 / (1u32 << 24) as f32;
+            let x = unit(nested_uniform_scramble(sobol0(i), h as u32));
+            let y = unit(nested_uniform_scramble(sobol1(i), (h >> 32) as u32));
+            if d % 2 == 0 {
+                assert_eq!(s.uniform2(), [x, y], "index {index} dim {d}");
+            } else {
+                assert_eq!(s.uniform(), x, "index {index} dim {d}");
+            }
+        }
+    }
 }
