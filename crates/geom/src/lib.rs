@@ -15,9 +15,11 @@
 
 mod accel;
 mod bounds;
+mod bvh4;
 pub mod float;
 mod mesh;
 mod ray;
+mod simd;
 mod sphere;
 
 pub use accel::{BvhKind, Geometry, Hit, Prim};

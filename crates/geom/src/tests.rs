@@ -236,7 +236,7 @@ fn test_scene(kind: BvhKind) -> Geometry {
 
 #[test]
 fn bvh_closest_hits_equal_brute_force() {
-    for kind in [BvhKind::CwBvh, BvhKind::Bvh2] {
+    for kind in [BvhKind::Bvh4, BvhKind::CwBvh] {
         let geo = test_scene(kind);
         let mut rng = Rng::new(99);
         let mut hits = 0;
@@ -455,7 +455,7 @@ fn shading_normals_interpolate_and_face_the_same_side() {
 #[test]
 fn hits_closer_than_the_bvh_node_epsilon_are_found() {
     // obvhs' CwBvh skips nodes closer than t = 1e-4; `Geometry` must not (see T_SHIFT).
-    for kind in [BvhKind::CwBvh, BvhKind::Bvh2] {
+    for kind in [BvhKind::Bvh4, BvhKind::CwBvh] {
         let floor = quad(
             Vec3::new(-1.0, 0.0, -1.0),
             Vec3::new(-1.0, 0.0, 1.0),
@@ -489,7 +489,7 @@ fn hits_closer_than_the_bvh_node_epsilon_are_found() {
 fn directions_with_negative_zero_components_hit() {
     // Regression: -Vec3::Y is (-0, -1, -0); obvhs chose the octant and the inverse direction
     // with different signs for -0.0 and the CwBvh missed the floor.
-    for kind in [BvhKind::CwBvh, BvhKind::Bvh2] {
+    for kind in [BvhKind::Bvh4, BvhKind::CwBvh] {
         let floor = quad(
             Vec3::new(-1.0, 0.0, -1.0),
             Vec3::new(-1.0, 0.0, 1.0),
