@@ -70,7 +70,9 @@ impl Geometry {
     pub fn with_bvh(mesh: TriMesh, spheres: Vec<Sphere>, kind: BvhKind) -> Geometry {
         let (accel, order, rt) = match kind {
             BvhKind::Bvh4 => {
-                // BVH_PARAMS_MEASURED
+                // `slow_build` and `very_slow_build` (more PLOC search, more reinsertion; their
+                // spatial pre-splits do not apply to a build from boxes) traversed within noise
+                // of `medium_build` on the tessellated Cornell scene (`bench-rays`, one run).
                 let params = BvhBuildParams::medium_build();
                 match Bvh4::build(&mesh, &spheres, params) {
                     Some(b) => (Accel::Bvh4(b), Vec::new(), Vec::new()),
