@@ -537,12 +537,15 @@ fn spheres_inside_the_bvh_give_the_closest_of_all_primitives() {
     let (mut sphere_hits, mut tri_hits) = (0, 0);
     for _ in 0..20_000 {
         let ray = Ray {
-            t_max: if rng.uniform() < 0.5 { f32::INFINITY } else { 4.0 },
+            t_max: if rng.uniform() < 0.5 {
+                f32::INFINITY
+            } else {
+                4.0
+            },
             ..Ray::new(rand_vec(&mut rng, -6.0, 6.0), rand_dir(&mut rng))
         };
-        let mut want: Option<(f32, Prim)> = tris_only
-            .intersect_brute_force(&ray)
-            .map(|h| (h.t, h.prim));
+        let mut want: Option<(f32, Prim)> =
+            tris_only.intersect_brute_force(&ray).map(|h| (h.t, h.prim));
         for (i, s) in spheres.iter().enumerate() {
             if let Some(t) = s.intersect(&ray)
                 && want.is_none_or(|(w, _)| t < w)
@@ -566,7 +569,10 @@ fn spheres_inside_the_bvh_give_the_closest_of_all_primitives() {
         }
         assert_eq!(geo.occluded(&ray), want.is_some());
     }
-    assert!(sphere_hits > 2_000 && tri_hits > 2_000, "{sphere_hits} {tri_hits}");
+    assert!(
+        sphere_hits > 2_000 && tri_hits > 2_000,
+        "{sphere_hits} {tri_hits}"
+    );
 }
 
 #[test]
@@ -575,7 +581,11 @@ fn rays_through_shared_edges_and_vertices_of_a_closed_mesh_never_slip_through() 
     // exactly at vertices and at points on shared edges are where a non-watertight test
     // (each triangle rounding its own edge functions) lets rays pass between neighbours.
     let (pos, idx) = uv_sphere(Vec3::new(0.3, -0.2, 0.1), 2.0, 96, 48);
-    let geo = Geometry::with_bvh(mesh_of(&[(pos.clone(), idx.clone())]), vec![], BvhKind::Bvh4);
+    let geo = Geometry::with_bvh(
+        mesh_of(&[(pos.clone(), idx.clone())]),
+        vec![],
+        BvhKind::Bvh4,
+    );
     let mut rng = Rng::new(23);
     let mut cast = 0;
     for (k, tri) in idx.iter().enumerate() {
@@ -584,7 +594,10 @@ fn rays_through_shared_edges_and_vertices_of_a_closed_mesh_never_slip_through() 
         for target in [a, b, c, a + s * (b - a), b + s * (c - b), c + s * (a - c)] {
             let o = Vec3::new(0.3, -0.2, 0.1) + rand_vec(&mut rng, -1.0, 1.0);
             let ray = Ray::new(o, target - o);
-            assert!(geo.intersect(&ray).is_some(), "triangle {k}: slipped through");
+            assert!(
+                geo.intersect(&ray).is_some(),
+                "triangle {k}: slipped through"
+            );
             assert!(
                 geo.occluded(&Ray { t_max: 2.0, ..ray }),
                 "triangle {k}: shadow ray slipped through"
