@@ -1,26 +1,27 @@
+use crate::bvh4::Bvh4;
 use crate::float::gamma;
 use crate::{Bounds3, Ray, Sphere, SurfacePoint, TriMesh};
 use glam::{Vec3, Vec3A};
 use obvhs::{
-    BvhBuildParams, bvh2::Bvh2, bvh2::builder::build_bvh2_from_tris, cwbvh::CwBvh,
-    cwbvh::builder::build_cwbvh_from_tris, ray::RayHit, rt_triangle::RtTriangle,
-    triangle::Triangle,
+    BvhBuildParams, cwbvh::CwBvh, cwbvh::builder::build_cwbvh_from_tris, ray::RayHit,
+    rt_triangle::RtTriangle, triangle::Triangle,
 };
 use std::time::Duration;
 
-/// Which `obvhs` hierarchy indexes the triangles.
+/// Which hierarchy indexes the primitives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum BvhKind {
-    /// Binary BVH (PLOC + reinsertion).
-    Bvh2,
-    /// 8-wide compressed BVH (Ylitie et al. 2017), traversed 4 nodes at a time with SIMD.
+    /// Our 4-wide BVH over triangles and spheres (module `bvh4`).
     #[default]
+    Bvh4,
+    /// obvhs' 8-wide compressed BVH (Ylitie et al. 2017) over the triangles, spheres tested
+    /// beside it: the previous default, kept for `bench-rays --compare`.
     CwBvh,
 }
 
 enum Accel {
     None,
-    Bvh2(Bvh2),
+    Bvh4(Bvh4),
     CwBvh(CwBvh),
 }
 
@@ -47,14 +48,14 @@ pub struct Hit {
     pub material: u32,
 }
 
-/// The scene's ray-casting structure: triangles under a BVH, spheres beside it.
+/// The scene's ray-casting structure: triangles and spheres under one BVH.
 pub struct Geometry {
     mesh: TriMesh,
     spheres: Vec<Sphere>,
     accel: Accel,
     kind: BvhKind,
-    /// Triangles in BVH leaf order (obvhs' `primitive_indices`), so traversal reads them
-    /// contiguously without the extra indirection.
+    /// `CwBvh` only: triangles in BVH leaf order (obvhs' `primitive_indices`), so traversal
+    /// reads them contiguously without the extra indirection.
     rt: Vec<RtTriangle>,
     /// Original triangle id of each entry of `rt`.
     rt_ids: Vec<u32>,
@@ -67,41 +68,42 @@ impl Geometry {
     }
 
     pub fn with_bvh(mesh: TriMesh, spheres: Vec<Sphere>, kind: BvhKind) -> Geometry {
-        let tris: Vec<Triangle> = (0..mesh.len())
-            .map(|i| {
-                let [a, b, c] = mesh.vertices(i);
-                Triangle {
-                    v0: a.into(),
-                    v1: b.into(),
-                    v2: c.into(),
+        let (accel, order, rt) = match kind {
+            BvhKind::Bvh4 => {
+                // `slow_build` and `very_slow_build` (more PLOC search, more reinsertion; their
+                // spatial pre-splits do not apply to a build from boxes) traversed within noise
+                // of `medium_build` on the tessellated Cornell scene (`bench-rays`, one run).
+                let params = BvhBuildParams::medium_build();
+                match Bvh4::build(&mesh, &spheres, params) {
+                    Some(b) => (Accel::Bvh4(b), Vec::new(), Vec::new()),
+                    None => (Accel::None, Vec::new(), Vec::new()),
                 }
-            })
-            .collect();
-        // `medium_build` traversed as fast as `slow_build` (spatial pre-splits) and
-        // `very_slow_build` on the tessellated Cornell scene (`cargo xtask bench rays`, medians
-        // within noise of each other) and builds in half the time (~10 ms for 16k triangles).
-        let params = BvhBuildParams::medium_build();
-        let mut t = Duration::default();
-        let (accel, order): (Accel, Vec<u32>) = if tris.is_empty() {
-            (Accel::None, Vec::new())
-        } else {
-            match kind {
-                BvhKind::Bvh2 => {
-                    let b = build_bvh2_from_tris(&tris, params, &mut t);
+            }
+            BvhKind::CwBvh => {
+                let tris: Vec<Triangle> = (0..mesh.len())
+                    .map(|i| {
+                        let [a, b, c] = mesh.vertices(i);
+                        Triangle {
+                            v0: a.into(),
+                            v1: b.into(),
+                            v2: c.into(),
+                        }
+                    })
+                    .collect();
+                if tris.is_empty() {
+                    (Accel::None, Vec::new(), Vec::new())
+                } else {
+                    let params = BvhBuildParams::medium_build();
+                    let b = build_cwbvh_from_tris(&tris, params, &mut Duration::default());
                     let order = b.primitive_indices.clone();
-                    (Accel::Bvh2(b), order)
-                }
-                BvhKind::CwBvh => {
-                    let b = build_cwbvh_from_tris(&tris, params, &mut t);
-                    let order = b.primitive_indices.clone();
-                    (Accel::CwBvh(b), order)
+                    let rt = order
+                        .iter()
+                        .map(|&i| RtTriangle::from(&tris[i as usize]))
+                        .collect();
+                    (Accel::CwBvh(b), order, rt)
                 }
             }
         };
-        let rt = order
-            .iter()
-            .map(|&i| RtTriangle::from(&tris[i as usize]))
-            .collect();
         let bounds = spheres.iter().fold(mesh.bounds(), |b, s| {
             b.union_point(s.center - Vec3::splat(s.radius))
                 .union_point(s.center + Vec3::splat(s.radius))
@@ -135,6 +137,22 @@ impl Geometry {
 
     /// Closest hit with `0 < t < ray.t_max`.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        let (t, prim) = match &self.accel {
+            Accel::Bvh4(b) => b.intersect(ray, &self.spheres)?,
+            _ => self.intersect_cwbvh(ray)?,
+        };
+        Some(self.hit(ray, prim, t))
+    }
+
+    fn hit(&self, ray: &Ray, prim: Prim, t: f32) -> Hit {
+        match prim {
+            Prim::Sphere(i) => self.sphere_hit(ray, i, t),
+            Prim::Triangle(id) => self.triangle_hit(ray, id as usize, t),
+        }
+    }
+
+    /// The previous path: spheres one by one, then obvhs' `CwBvh` over the triangles.
+    fn intersect_cwbvh(&self, ray: &Ray) -> Option<(f32, Prim)> {
         let (mut best_t, mut best) = self.closest_sphere(ray);
         let (shifted, real) = to_obvhs(ray, best_t);
         let mut hit = RayHit::none();
@@ -156,23 +174,22 @@ impl Geometry {
             ts
         };
         let found = match &self.accel {
-            Accel::None => false,
             Accel::CwBvh(b) => b.ray_traverse(shifted, &mut hit, test),
-            Accel::Bvh2(b) => b.ray_traverse(shifted, &mut hit, test),
+            _ => false,
         };
         let t = closest.get();
         if found && t < best_t {
             best_t = t;
-            best = Some(Prim::Triangle(hit.primitive_id));
+            best = Some(Prim::Triangle(self.rt_ids[hit.primitive_id as usize]));
         }
-        match best? {
-            Prim::Sphere(i) => Some(self.sphere_hit(ray, i, best_t)),
-            Prim::Triangle(slot) => Some(self.triangle_hit(ray, slot as usize, best_t)),
-        }
+        best.map(|p| (best_t, p))
     }
 
     /// True if anything is hit with `0 < t < ray.t_max` (shadow rays).
     pub fn occluded(&self, ray: &Ray) -> bool {
+        if let Accel::Bvh4(b) = &self.accel {
+            return b.occluded(ray, &self.spheres);
+        }
         if self.spheres.iter().any(|s| s.intersect(ray).is_some()) {
             return true;
         }
@@ -180,14 +197,21 @@ impl Geometry {
         let (shifted, real) = to_obvhs(ray, ray.t_max);
         let test = |_: &obvhs::ray::Ray, i: usize| intersect_triangle(&rt[i], &real) + T_SHIFT;
         match &self.accel {
-            Accel::None => false,
             Accel::CwBvh(b) => !b.ray_traverse_miss(shifted, test),
-            Accel::Bvh2(b) => !b.ray_traverse_miss(shifted, test),
+            _ => false,
         }
     }
 
     /// Closest hit by testing every primitive: the reference the BVH is tested against.
     pub fn intersect_brute_force(&self, ray: &Ray) -> Option<Hit> {
+        let (t, prim) = match &self.accel {
+            Accel::Bvh4(b) => b.brute_force(ray, &self.spheres)?,
+            _ => self.brute_force_cwbvh(ray)?,
+        };
+        Some(self.hit(ray, prim, t))
+    }
+
+    fn brute_force_cwbvh(&self, ray: &Ray) -> Option<(f32, Prim)> {
         let (mut best_t, mut best) = self.closest_sphere(ray);
         let (_, real) = to_obvhs(ray, best_t);
         for (slot, tri) in self.rt.iter().enumerate() {
@@ -200,13 +224,10 @@ impl Geometry {
             );
             if t < best_t {
                 best_t = t;
-                best = Some(Prim::Triangle(slot as u32));
+                best = Some(Prim::Triangle(self.rt_ids[slot]));
             }
         }
-        match best? {
-            Prim::Sphere(i) => Some(self.sphere_hit(ray, i, best_t)),
-            Prim::Triangle(slot) => Some(self.triangle_hit(ray, slot as usize, best_t)),
-        }
+        best.map(|p| (best_t, p))
     }
 
     /// The nearest sphere hit below `ray.t_max` (spheres are few: tested one by one).
@@ -239,17 +260,16 @@ impl Geometry {
         }
     }
 
-    fn triangle_hit(&self, ray: &Ray, slot: usize, t: f32) -> Hit {
-        let id = self.rt_ids[slot] as usize;
-        let tri = &self.rt[slot];
-        // Barycentrics of the hit for vertices 1 and 2. `RtTriangle` stores e1 = v0 - v1 and
-        // e2 = v2 - v0, so its (u, v) are the weights of v1 and v2.
-        let r = ray.d.cross(Vec3::from(tri.v0) - ray.o);
-        let det = Vec3::from(tri.ng).dot(ray.d);
-        let b1 = r.dot(Vec3::from(tri.e2)) / det;
-        let b2 = r.dot(Vec3::from(tri.e1)) / det;
-        let b0 = 1.0 - b1 - b2;
+    fn triangle_hit(&self, ray: &Ray, id: usize, t: f32) -> Hit {
         let pv = self.mesh.vertices(id);
+        // Barycentrics of the hit for vertices 1 and 2 (Möller–Trumbore's u, v with
+        // e1 = v0 - v1, e2 = v2 - v0, the layout of obvhs' `RtTriangle`).
+        let (e1, e2) = (pv[0] - pv[1], pv[2] - pv[0]);
+        let r = ray.d.cross(pv[0] - ray.o);
+        let det = e1.cross(e2).dot(ray.d);
+        let b1 = r.dot(e2) / det;
+        let b2 = r.dot(e1) / det;
+        let b0 = 1.0 - b1 - b2;
         let p = b0 * pv[0] + b1 * pv[1] + b2 * pv[2];
         let p_err = SurfacePoint::barycentric_error([b0, b1, b2], pv);
         let mut ng = (pv[1] - pv[0]).cross(pv[2] - pv[0]).normalize_or_zero();

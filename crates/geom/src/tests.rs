@@ -236,7 +236,7 @@ fn test_scene(kind: BvhKind) -> Geometry {
 
 #[test]
 fn bvh_closest_hits_equal_brute_force() {
-    for kind in [BvhKind::CwBvh, BvhKind::Bvh2] {
+    for kind in [BvhKind::Bvh4, BvhKind::CwBvh] {
         let geo = test_scene(kind);
         let mut rng = Rng::new(99);
         let mut hits = 0;
@@ -455,7 +455,7 @@ fn shading_normals_interpolate_and_face_the_same_side() {
 #[test]
 fn hits_closer_than_the_bvh_node_epsilon_are_found() {
     // obvhs' CwBvh skips nodes closer than t = 1e-4; `Geometry` must not (see T_SHIFT).
-    for kind in [BvhKind::CwBvh, BvhKind::Bvh2] {
+    for kind in [BvhKind::Bvh4, BvhKind::CwBvh] {
         let floor = quad(
             Vec3::new(-1.0, 0.0, -1.0),
             Vec3::new(-1.0, 0.0, 1.0),
@@ -489,7 +489,7 @@ fn hits_closer_than_the_bvh_node_epsilon_are_found() {
 fn directions_with_negative_zero_components_hit() {
     // Regression: -Vec3::Y is (-0, -1, -0); obvhs chose the octant and the inverse direction
     // with different signs for -0.0 and the CwBvh missed the floor.
-    for kind in [BvhKind::CwBvh, BvhKind::Bvh2] {
+    for kind in [BvhKind::Bvh4, BvhKind::CwBvh] {
         let floor = quad(
             Vec3::new(-1.0, 0.0, -1.0),
             Vec3::new(-1.0, 0.0, 1.0),
@@ -510,4 +510,100 @@ fn directions_with_negative_zero_components_hit() {
             }));
         }
     }
+}
+
+#[test]
+fn spheres_inside_the_bvh_give_the_closest_of_all_primitives() {
+    // Many spheres among triangles: the BVH's closest hit must be the minimum of every
+    // sphere's own root finder and a brute-force pass over the triangles alone.
+    let mut rng = Rng::new(17);
+    let spheres: Vec<Sphere> = (0..300)
+        .map(|i| Sphere {
+            center: rand_vec(&mut rng, -5.0, 5.0),
+            radius: 0.05 + 0.4 * rng.uniform(),
+            material: 100 + i,
+        })
+        .collect();
+    let mut parts = vec![uv_sphere(Vec3::new(1.0, -1.0, 0.5), 1.2, 24, 12)];
+    parts.push(quad(
+        Vec3::new(-5.0, -5.0, -5.0),
+        Vec3::new(-5.0, -5.0, 5.0),
+        Vec3::new(5.0, -5.0, 5.0),
+        Vec3::new(5.0, -5.0, -5.0),
+    ));
+    let mesh = mesh_of(&parts);
+    let tris_only = Geometry::with_bvh(mesh.clone(), vec![], BvhKind::Bvh4);
+    let geo = Geometry::with_bvh(mesh, spheres.clone(), BvhKind::Bvh4);
+    let (mut sphere_hits, mut tri_hits) = (0, 0);
+    for _ in 0..20_000 {
+        let ray = Ray {
+            t_max: if rng.uniform() < 0.5 {
+                f32::INFINITY
+            } else {
+                4.0
+            },
+            ..Ray::new(rand_vec(&mut rng, -6.0, 6.0), rand_dir(&mut rng))
+        };
+        let mut want: Option<(f32, Prim)> =
+            tris_only.intersect_brute_force(&ray).map(|h| (h.t, h.prim));
+        for (i, s) in spheres.iter().enumerate() {
+            if let Some(t) = s.intersect(&ray)
+                && want.is_none_or(|(w, _)| t < w)
+            {
+                want = Some((t, Prim::Sphere(i as u32)));
+            }
+        }
+        let got = geo.intersect(&ray).map(|h| (h.t, h.prim));
+        match (got, want) {
+            (Some((t, p)), Some((wt, wp))) => {
+                assert_eq!(t, wt);
+                if let Prim::Sphere(_) = wp {
+                    assert_eq!(p, wp);
+                    sphere_hits += 1;
+                } else {
+                    tri_hits += 1;
+                }
+            }
+            (None, None) => {}
+            (g, w) => panic!("bvh {g:?} vs all primitives {w:?}"),
+        }
+        assert_eq!(geo.occluded(&ray), want.is_some());
+    }
+    assert!(
+        sphere_hits > 2_000 && tri_hits > 2_000,
+        "{sphere_hits} {tri_hits}"
+    );
+}
+
+#[test]
+fn rays_through_shared_edges_and_vertices_of_a_closed_mesh_never_slip_through() {
+    // A closed UV sphere: from inside, every ray leaves through some triangle. Rays aimed
+    // exactly at vertices and at points on shared edges are where a non-watertight test
+    // (each triangle rounding its own edge functions) lets rays pass between neighbours.
+    let (pos, idx) = uv_sphere(Vec3::new(0.3, -0.2, 0.1), 2.0, 96, 48);
+    let geo = Geometry::with_bvh(
+        mesh_of(&[(pos.clone(), idx.clone())]),
+        vec![],
+        BvhKind::Bvh4,
+    );
+    let mut rng = Rng::new(23);
+    let mut cast = 0;
+    for (k, tri) in idx.iter().enumerate() {
+        let [a, b, c] = tri.map(|i| pos[i as usize]);
+        let s = rng.uniform();
+        for target in [a, b, c, a + s * (b - a), b + s * (c - b), c + s * (a - c)] {
+            let o = Vec3::new(0.3, -0.2, 0.1) + rand_vec(&mut rng, -1.0, 1.0);
+            let ray = Ray::new(o, target - o);
+            assert!(
+                geo.intersect(&ray).is_some(),
+                "triangle {k}: slipped through"
+            );
+            assert!(
+                geo.occluded(&Ray { t_max: 2.0, ..ray }),
+                "triangle {k}: shadow ray slipped through"
+            );
+            cast += 1;
+        }
+    }
+    assert!(cast > 50_000);
 }

@@ -33,9 +33,15 @@ enum Cmd {
         /// Rays per run.
         #[arg(long, default_value_t = 1 << 20)]
         rays: usize,
-        /// Also measure the binary BVH (Bvh2) next to the default CwBvh.
+        /// Also measure obvhs' CwBvh (spheres beside it) next to the default BVH4.
         #[arg(long)]
         compare: bool,
+        /// Cast the rays of `DIR/coherent_rays.f32` and `DIR/incoherent_rays.f32` (rows of
+        /// six little-endian f32: origin, direction) instead of generating them (`--rays` is
+        /// then ignored); with `DIR/SET_hit_t.npy` also report agreement with those
+        /// closest-hit distances (inf = miss).
+        #[arg(long, value_name = "DIR")]
+        ray_dir: Option<PathBuf>,
     },
     /// Photon paths/s on 1 and 2 threads, tracing only and through the pipeline to files.
     BenchPhotons {
@@ -419,7 +425,8 @@ fn run(cmd: Cmd) -> Result<(), String> {
             runs,
             rays,
             compare,
-        } => pipeline::bench::rays(&scene, runs, rays, compare),
+            ray_dir,
+        } => pipeline::bench::rays(&scene, runs, rays, compare, ray_dir.as_deref()),
         Cmd::Render {
             scene,
             method,

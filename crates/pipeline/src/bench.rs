@@ -8,24 +8,62 @@ use math::Rng;
 use std::path::Path;
 use std::time::Instant;
 
-pub fn rays(path: &Path, runs: usize, count: usize, compare: bool) -> Result<(), String> {
+pub fn rays(
+    path: &Path,
+    runs: usize,
+    count: usize,
+    compare: bool,
+    ray_dir: Option<&Path>,
+) -> Result<(), String> {
     if runs == 0 || count == 0 {
         return Err("--runs and --rays must be positive".into());
     }
     let s = scene::Scene::load(path).map_err(|e| e.to_string())?;
-    let coherent = camera_rays(&s.camera, count);
-    let incoherent = random_rays(&s.geometry, count, s.seed());
+    // Each set: name, rays, and (ray files only) the reference's closest-hit distances.
+    let mut sets: Vec<RaySet> = Vec::new();
+    match ray_dir {
+        None => {
+            sets.push(("coherent", camera_rays(&s.camera, count), None));
+            sets.push((
+                "incoherent",
+                random_rays(&s.geometry, count, s.seed()),
+                None,
+            ));
+        }
+        Some(dir) => {
+            for name in ["coherent", "incoherent"] {
+                let rays = read_ray_file(&dir.join(format!("{name}_rays.f32")))?;
+                let t_file = dir.join(format!("{name}_hit_t.npy"));
+                let reference = if t_file.exists() {
+                    let t = read_npy_f32(&t_file)?;
+                    if t.len() != rays.len() {
+                        return Err(format!(
+                            "{}: {} distances for {} rays",
+                            t_file.display(),
+                            t.len(),
+                            rays.len()
+                        ));
+                    }
+                    Some(t)
+                } else {
+                    None
+                };
+                sets.push((name, rays, reference));
+            }
+        }
+    }
     println!(
-        "scene {} ({} triangles, {} spheres), {} rays per run, median of {} runs, 1 thread",
+        "scene {} ({} triangles, {} spheres), {} rays per run{}, median of {} runs, 1 thread",
         path.display(),
         s.geometry.mesh().len(),
         s.geometry.spheres().len(),
-        count,
+        sets[0].1.len(),
+        ray_dir.map_or(String::new(), |d| format!(" from {}", d.display())),
         runs
     );
-    let mut kinds = vec![BvhKind::CwBvh];
+    let mut kinds = vec![BvhKind::Bvh4];
     if compare {
-        kinds.push(BvhKind::Bvh2);
+        kinds.push(BvhKind::CwBvh);
     }
     for kind in kinds {
         let t0 = Instant::now();
@@ -35,16 +73,142 @@ pub fn rays(path: &Path, runs: usize, count: usize, compare: bool) -> Result<(),
             kind,
         );
         let build = t0.elapsed();
-        for (name, rays) in [("coherent", &coherent), ("incoherent", &incoherent)] {
+        for (name, rays, reference) in &sets {
             let (mrays, hits) = median_rate(&geo, rays, runs);
             println!(
                 "{name:>10}: {mrays:7.2} M rays/s  ({kind:?}, build {:.1} ms, {:.1}% hit)",
                 build.as_secs_f64() * 1e3,
                 100.0 * hits as f64 / rays.len() as f64
             );
+            if let Some(t_ref) = reference {
+                let a = agreement(&geo, rays, t_ref);
+                println!(
+                    "{:>10}  vs reference hits: hit/miss agree on {:.4}% of rays; closest-hit distance within 1e-4 relative on {:.4}% of rays ({:.4}% of rays both hit)",
+                    "",
+                    100.0 * a.hit_miss as f64 / rays.len() as f64,
+                    100.0 * a.agree as f64 / rays.len() as f64,
+                    100.0 * a.t_close as f64 / a.both_hit.max(1) as f64,
+                );
+            }
         }
     }
     Ok(())
+}
+
+/// A named ray set and, from ray files, the reference's closest-hit distances.
+type RaySet = (&'static str, Vec<Ray>, Option<Vec<f32>>);
+
+/// How our closest hits compare with a reference's distances (`inf` = miss).
+struct Agreement {
+    /// Rays both call a hit, or both a miss.
+    hit_miss: usize,
+    both_hit: usize,
+    /// Rays both hit with `|t - t_ref| <= 1e-4 t_ref`.
+    t_close: usize,
+    /// Rays both miss or both hit within that tolerance.
+    agree: usize,
+}
+
+fn agreement(geo: &Geometry, rays: &[Ray], t_ref: &[f32]) -> Agreement {
+    let mut a = Agreement {
+        hit_miss: 0,
+        both_hit: 0,
+        t_close: 0,
+        agree: 0,
+    };
+    for (r, &tr) in rays.iter().zip(t_ref) {
+        match (geo.intersect(r), tr.is_finite()) {
+            (None, false) => {
+                a.hit_miss += 1;
+                a.agree += 1;
+            }
+            (Some(h), true) => {
+                a.hit_miss += 1;
+                a.both_hit += 1;
+                if (h.t - tr).abs() <= 1e-4 * tr {
+                    a.t_close += 1;
+                    a.agree += 1;
+                }
+            }
+            _ => {}
+        }
+    }
+    a
+}
+
+/// Rays as raw little-endian f32 rows `ox oy oz dx dy dz` (the peers' ray-file format).
+pub fn read_ray_file(path: &Path) -> Result<Vec<Ray>, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    if bytes.is_empty() || bytes.len() % 24 != 0 {
+        return Err(format!(
+            "{}: {} bytes is not a positive whole number of 24-byte rays (6 little-endian f32)",
+            path.display(),
+            bytes.len()
+        ));
+    }
+    let f: Vec<f32> = bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    f.chunks_exact(6)
+        .enumerate()
+        .map(|(i, r)| {
+            let (o, d) = (Vec3::new(r[0], r[1], r[2]), Vec3::new(r[3], r[4], r[5]));
+            if !(o.is_finite() && d.is_finite()) || d == Vec3::ZERO {
+                return Err(format!(
+                    "{}: ray {i} has a non-finite origin or direction or a zero direction",
+                    path.display()
+                ));
+            }
+            Ok(Ray::new(o, d))
+        })
+        .collect()
+}
+
+/// A 1-D little-endian f32 `.npy` array (NumPy format 1.0-3.0: magic, version, header
+/// length, a text header naming dtype and shape, then the raw data).
+pub fn read_npy_f32(path: &Path) -> Result<Vec<f32>, String> {
+    let err = |m: &str| format!("{}: {m}", path.display());
+    let bytes = std::fs::read(path).map_err(|e| err(&e.to_string()))?;
+    if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
+        return Err(err("not a .npy file"));
+    }
+    let (len, start) = match bytes[6] {
+        1 => (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10),
+        2 | 3 if bytes.len() >= 12 => (
+            u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize,
+            12,
+        ),
+        _ => return Err(err("unsupported .npy version")),
+    };
+    let header = bytes
+        .get(start..start + len)
+        .and_then(|h| std::str::from_utf8(h).ok())
+        .ok_or_else(|| err("truncated .npy header"))?;
+    let compact: String = header.chars().filter(|c| !c.is_whitespace()).collect();
+    if !compact.contains("'descr':'<f4'") || !compact.contains("'fortran_order':False") {
+        return Err(err("expected a little-endian f32 ('<f4') array in C order"));
+    }
+    let shape = compact
+        .split("'shape':(")
+        .nth(1)
+        .and_then(|s| s.split(')').next())
+        .ok_or_else(|| err("no shape in the .npy header"))?;
+    let n: usize = shape
+        .trim_end_matches(',')
+        .parse()
+        .map_err(|_| err("expected a 1-D array"))?;
+    let data = &bytes[start + len..];
+    if data.len() != 4 * n {
+        return Err(err(&format!(
+            "{} data bytes for {n} f32 values",
+            data.len()
+        )));
+    }
+    Ok(data
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect())
 }
 
 fn median_rate(geo: &Geometry, rays: &[Ray], runs: usize) -> (f64, usize) {
@@ -307,4 +471,79 @@ pub fn splat(path: &Path, photons: u64, runs: usize) -> Result<(), String> {
         _ => println!("peak memory: not available on this system"),
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod ray_file_tests {
+    use super::*;
+
+    fn tmp(name: &str) -> std::path::PathBuf {
+        let d = std::env::temp_dir().join(format!("pf-rayfile-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d.join(name)
+    }
+
+    #[test]
+    fn ray_file_round_trips_and_bad_lengths_name_the_file() {
+        let rows = [
+            [1.0f32, -2.5, 3.0, 0.0, -1.0, 0.0],
+            [0.1, 0.2, 0.3, 0.6, 0.0, 0.8],
+        ];
+        let bytes: Vec<u8> = rows
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let p = tmp("ok_rays.f32");
+        std::fs::write(&p, &bytes).unwrap();
+        let rays = read_ray_file(&p).unwrap();
+        assert_eq!(rays.len(), 2);
+        for (r, w) in rays.iter().zip(&rows) {
+            assert_eq!(r.o.to_array(), [w[0], w[1], w[2]]);
+            assert_eq!(r.d.to_array(), [w[3], w[4], w[5]]);
+            assert_eq!(r.t_max, f32::INFINITY);
+        }
+        let short = tmp("short_rays.f32");
+        std::fs::write(&short, &bytes[..bytes.len() - 1]).unwrap();
+        let e = read_ray_file(&short).unwrap_err();
+        assert!(
+            e.contains("short_rays.f32") && e.contains("47 bytes"),
+            "{e}"
+        );
+        std::fs::write(&short, []).unwrap();
+        assert!(read_ray_file(&short).is_err());
+        assert!(
+            read_ray_file(&tmp("missing.f32"))
+                .unwrap_err()
+                .contains("missing.f32")
+        );
+    }
+
+    fn npy(descr: &str, shape: &str, data: &[f32]) -> Vec<u8> {
+        let mut h = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+        while (10 + h.len() + 1) % 64 != 0 {
+            h.push(' ');
+        }
+        h.push('\n');
+        let mut b = b"\x93NUMPY\x01\x00".to_vec();
+        b.extend((h.len() as u16).to_le_bytes());
+        b.extend(h.bytes());
+        b.extend(data.iter().flat_map(|v| v.to_le_bytes()));
+        b
+    }
+
+    #[test]
+    fn npy_reader_reads_f32_vectors_and_rejects_others() {
+        let data = [1.5f32, f32::INFINITY, 0.25];
+        let p = tmp("t.npy");
+        std::fs::write(&p, npy("<f4", "(3,)", &data)).unwrap();
+        assert_eq!(read_npy_f32(&p).unwrap(), data);
+        for (descr, shape, n) in [("<i4", "(3,)", 3), ("<f4", "(4,)", 3), ("<f4", "(3, 1)", 3)] {
+            std::fs::write(&p, npy(descr, shape, &data[..n])).unwrap();
+            let e = read_npy_f32(&p).unwrap_err();
+            assert!(e.contains("t.npy"), "{e}");
+        }
+        std::fs::write(&p, b"not numpy").unwrap();
+        assert!(read_npy_f32(&p).is_err());
+    }
 }

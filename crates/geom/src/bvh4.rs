@@ -1,0 +1,580 @@
+//! The default acceleration structure: a 4-wide BVH with full-precision f32 child boxes in
+//! structure-of-arrays layout (one SSE compare tests all four children), collapsed from an
+//! obvhs `Bvh2` (PLOC + reinsertion). Triangles *and* spheres are its primitives, so a ray
+//! pays for a sphere only when it enters the sphere's box.
+//!
+//! Leaves hold up to `LEAF_MAX` triangles in blocks of four, tested together with the
+//! watertight test of Woop, Benthin and Wald (JCGT 2013), or one sphere.
+//!
+//! Why not obvhs' `CwBvh` traversal: it decodes 8-bit quantised child boxes on every visit
+//! (its own comments name that the most expensive step), clamps entry distances to
+//! `t >= 1e-4`, and calls the primitive test through a closure one triangle at a time.
+
+use crate::float::{gamma, next_down, next_up};
+use crate::simd::{F4, Lanes};
+use crate::{Prim, Ray, Sphere, TriMesh};
+use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::Bvh2, bvh2::builder::build_bvh2};
+use std::ops::{Add, Div, Mul, Sub};
+use std::time::Duration;
+
+/// Child reference: an inner node's index, or a leaf tagged by `LEAF`.
+const LEAF: u32 = 1 << 31;
+/// A leaf holding one sphere (index in the low bits).
+const SPHERE: u32 = 1 << 30;
+/// Triangle leaves: block count in bits 26..30, first block in bits 0..26.
+const COUNT_SHIFT: u32 = 26;
+const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
+const EMPTY: u32 = u32::MAX;
+
+/// Largest triangle leaf: one block of four. On the tessellated Cornell scene (`bench-rays`,
+/// one run, medians of 3) 2 and 8 were 10-15% slower on both ray sets.
+const LEAF_MAX: u32 = 4;
+
+/// Ize, "Robust BVH Ray Traversal" (JCGT 2013): scaling the exit distance by
+/// `1 + 2 gamma(3)` makes the slab test conservative for `(b - o) * (1 / d)`.
+fn robust() -> f32 {
+    1.0 + 2.0 * gamma(3)
+}
+
+/// Four children: boxes as `[min_x, max_x, min_y, max_y, min_z, max_z]` per lane. An empty
+/// slot has an inverted (+inf, -inf) box, which no ray enters.
+#[derive(Clone, Copy)]
+#[repr(C, align(64))]
+struct Node4 {
+    b: [[f32; 4]; 6],
+    child: [u32; 4],
+}
+
+/// Four triangles, structure of arrays: `v[vertex][axis][lane]`. A partly filled block
+/// repeats its last triangle, which can only return the same hit again.
+#[derive(Clone, Copy)]
+#[repr(C, align(16))]
+struct Tri4 {
+    v: [[[f32; 4]; 3]; 3],
+}
+
+pub(crate) struct Bvh4 {
+    nodes: Vec<Node4>,
+    tris: Vec<Tri4>,
+    /// Triangle id (in the `TriMesh`) of each lane of `tris`.
+    ids: Vec<[u32; 4]>,
+    root: u32,
+    /// Deepest stack a traversal can need (three pushes per level below the root).
+    stack_need: usize,
+}
+
+/// Per-ray constants of the box test (Williams et al. 2005: reciprocal direction and the
+/// near/far planes picked by its signs) and of the watertight triangle test (Woop et al.
+/// 2013 §3: the axis of largest `|d|` becomes z, and the shear that maps `d` onto it).
+struct RayData {
+    o: [F4; 3],
+    inv: [F4; 3],
+    near: [usize; 3],
+    far: [usize; 3],
+    k: [usize; 3],
+    s: [F4; 3],
+}
+
+impl RayData {
+    #[inline(always)]
+    fn new(ray: &Ray) -> RayData {
+        let d = ray.d.to_array();
+        let o = ray.o.to_array();
+        // The sign bit, not `d < 0`: 1 / -0.0 = -inf must take the far plane as its near one.
+        let neg = d.map(|x| x.is_sign_negative() as usize);
+        let a = ray.d.abs();
+        let kz = if a.x > a.y {
+            if a.x > a.z { 0 } else { 2 }
+        } else if a.y > a.z {
+            1
+        } else {
+            2
+        };
+        let kx = (kz + 1) % 3;
+        let ky = (kx + 1) % 3;
+        RayData {
+            o: o.map(F4::splat),
+            inv: d.map(|x| F4::splat(1.0 / x)),
+            near: [neg[0], 2 + neg[1], 4 + neg[2]],
+            far: [1 - neg[0], 3 - neg[1], 5 - neg[2]],
+            k: [kx, ky, kz],
+            s: [
+                F4::splat(-d[kx] / d[kz]),
+                F4::splat(-d[ky] / d[kz]),
+                F4::splat(1.0 / d[kz]),
+            ],
+        }
+    }
+
+    /// Mask of the children whose box the segment `[0, t_max]` enters, and their entry
+    /// distances. A NaN slab distance (origin on a plane of a box the ray runs parallel to)
+    /// leaves the interval as it was, so that case counts as inside.
+    #[inline(always)]
+    fn node(&self, n: &Node4, t_max: f32) -> (u32, F4) {
+        let slab = |i: usize, a: usize| F4::from_array(n.b[i]).sub(self.o[a]).mul(self.inv[a]);
+        let tn = slab(self.near[2], 2).max_into(
+            slab(self.near[1], 1).max_into(slab(self.near[0], 0).max_into(F4::splat(0.0))),
+        );
+        let tf = slab(self.far[2], 2).min_into(
+            slab(self.far[1], 1).min_into(slab(self.far[0], 0).min_into(F4::splat(t_max))),
+        );
+        (tn.le(tf.mul(F4::splat(robust()))), tn)
+    }
+
+    /// Woop, Benthin and Wald 2013 on four triangles, in pbrt-v4's form (§6.5.3) with its
+    /// conservative `t > 0` bound (§6.8.7): a ray spawned from a triangle's surface never
+    /// re-hits it at `t ~ 0`. Edge functions are evaluated on the sheared vertices, which
+    /// depend only on the ray and the vertex, so two triangles sharing an edge see the same
+    /// values with opposite signs and no ray passes between them. Returns the mask of lanes
+    /// hit with `0 < t < t_max`, and their `t`.
+    #[inline(always)]
+    fn tri4(&self, tri: &Tri4, t_max: f32) -> (u32, [f32; 4]) {
+        let [kx, ky, kz] = self.k;
+        let [sx, sy, sz] = self.s;
+        let vert = |j: usize| {
+            let z = F4::from_array(tri.v[j][kz]).sub(self.o[kz]);
+            let x = F4::from_array(tri.v[j][kx]).sub(self.o[kx]).add(sx.mul(z));
+            let y = F4::from_array(tri.v[j][ky]).sub(self.o[ky]).add(sy.mul(z));
+            (x, y, z)
+        };
+        let (x0, y0, z0) = vert(0);
+        let (x1, y1, z1) = vert(1);
+        let (x2, y2, z2) = vert(2);
+        let mut e0 = x1.mul(y2).sub(y1.mul(x2));
+        let mut e1 = x2.mul(y0).sub(y2.mul(x0));
+        let mut e2 = x0.mul(y1).sub(y0.mul(x1));
+        let zero = F4::splat(0.0);
+        let on_edge = e0.eq(zero) | e1.eq(zero) | e2.eq(zero);
+        if on_edge != 0 {
+            // An edge function rounded to zero: redo it in f64, where the products of two
+            // f32 are exact (Woop et al. 2013 §4.1).
+            [e0, e1, e2] = edges_f64(on_edge, [x0, x1, x2], [y0, y1, y2], [e0, e1, e2]);
+        }
+        let neg = e0.lt(zero) | e1.lt(zero) | e2.lt(zero);
+        let pos = zero.lt(e0) | zero.lt(e1) | zero.lt(e2);
+        let det = e0.add(e1).add(e2);
+        let mut mask = !(neg & pos) & !det.eq(zero) & 0xf;
+        if mask == 0 {
+            return (0, [0.0; 4]);
+        }
+        let (z0, z1, z2) = (z0.mul(sz), z1.mul(sz), z2.mul(sz));
+        let ts = e0.mul(z0).add(e1.mul(z1)).add(e2.mul(z2));
+        let tmd = F4::splat(t_max).mul(det);
+        let dneg = det.lt(zero);
+        mask &= (dneg & ts.lt(zero) & tmd.le(ts)) | (!dneg & zero.lt(ts) & ts.le(tmd));
+        if mask == 0 {
+            return (0, [0.0; 4]);
+        }
+        let inv_det = F4::splat(1.0).div(det);
+        let t = ts.mul(inv_det);
+        let max3 = |a: F4, b: F4, c: F4| a.abs().max_into(b.abs().max_into(c.abs()));
+        let max_z = max3(z0, z1, z2);
+        let max_x = max3(x0, x1, x2);
+        let max_y = max3(y0, y1, y2);
+        let max_e = max3(e0, e1, e2);
+        let g = |n: i32| F4::splat(gamma(n));
+        let dz = g(3).mul(max_z);
+        let dx = g(5).mul(max_x.add(max_z));
+        let dy = g(5).mul(max_y.add(max_z));
+        let de = F4::splat(2.0).mul(
+            g(2).mul(max_x)
+                .mul(max_y)
+                .add(dy.mul(max_x))
+                .add(dx.mul(max_y)),
+        );
+        let dt = F4::splat(3.0)
+            .mul(
+                g(3).mul(max_e)
+                    .mul(max_z)
+                    .add(de.mul(max_z))
+                    .add(dz.mul(max_e)),
+            )
+            .mul(inv_det.abs());
+        mask &= dt.lt(t) & t.lt(F4::splat(t_max));
+        (mask, t.to_array())
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn edges_f64(lanes: u32, x: [F4; 3], y: [F4; 3], e: [F4; 3]) -> [F4; 3] {
+    let x = x.map(|v| v.to_array());
+    let y = y.map(|v| v.to_array());
+    let mut e = e.map(|v| v.to_array());
+    for l in (0..4).filter(|l| lanes & (1 << l) != 0) {
+        let f = |a: usize, b: usize| {
+            let (xa, ya, xb, yb) = (
+                x[a][l] as f64,
+                y[a][l] as f64,
+                x[b][l] as f64,
+                y[b][l] as f64,
+            );
+            (xa * yb - ya * xb) as f32
+        };
+        e[0][l] = f(1, 2);
+        e[1][l] = f(2, 0);
+        e[2][l] = f(0, 1);
+    }
+    e.map(F4::from_array)
+}
+
+/// Traversal stack entry: child reference and the distance at which the ray enters it.
+type Entry = (u32, f32);
+
+/// Stack size that covers every BVH whose traversal needs at most this many entries;
+/// deeper ones (degenerate input) use a heap stack.
+const INLINE_STACK: usize = 40;
+
+impl Bvh4 {
+    /// `None` when there is nothing to index.
+    pub(crate) fn build(
+        mesh: &TriMesh,
+        spheres: &[Sphere],
+        params: BvhBuildParams,
+    ) -> Option<Bvh4> {
+        let n_tri = mesh.len();
+        let mut aabbs: Vec<Aabb> = (0..n_tri)
+            .map(|i| {
+                let [a, b, c] = mesh.vertices(i);
+                Aabb::new(a.min(b).min(c).into(), a.max(b).max(c).into())
+            })
+            .collect();
+        // The f32 box of a sphere, widened by an ulp so it contains the exact sphere.
+        aabbs.extend(spheres.iter().map(|s| {
+            let lo = (s.center - s.radius).to_array().map(next_down);
+            let hi = (s.center + s.radius).to_array().map(next_up);
+            Aabb::new(glam::Vec3A::from_array(lo), glam::Vec3A::from_array(hi))
+        }));
+        if aabbs.is_empty() {
+            return None;
+        }
+        // One primitive per Bvh2 leaf: the collapse below forms the leaves, and keeps
+        // spheres out of triangle blocks.
+        let params = BvhBuildParams {
+            max_prims_per_leaf: 1,
+            ..params
+        };
+        let bvh2 = build_bvh2(&aabbs, params, &mut Duration::default());
+        let mut b = Builder {
+            bvh2: &bvh2,
+            n_tri: n_tri as u32,
+            mesh,
+            count: vec![0; bvh2.nodes.len()],
+            has_sphere: vec![false; bvh2.nodes.len()],
+            out: Bvh4 {
+                nodes: Vec::new(),
+                tris: Vec::new(),
+                ids: Vec::new(),
+                root: EMPTY,
+                stack_need: 1,
+            },
+        };
+        b.stats(0);
+        let (root, depth) = b.emit(0);
+        b.out.root = root;
+        b.out.stack_need = 3 * depth + 1;
+        Some(b.out)
+    }
+
+    /// Closest hit with `0 < t < ray.t_max`.
+    #[inline]
+    pub(crate) fn intersect(&self, ray: &Ray, spheres: &[Sphere]) -> Option<(f32, Prim)> {
+        if self.stack_need <= INLINE_STACK {
+            self.closest(ray, spheres, &mut [(0, 0.0); INLINE_STACK])
+        } else {
+            self.closest(ray, spheres, &mut vec![(0, 0.0); self.stack_need])
+        }
+    }
+
+    /// True if anything is hit with `0 < t < ray.t_max`; stops at the first hit.
+    #[inline]
+    pub(crate) fn occluded(&self, ray: &Ray, spheres: &[Sphere]) -> bool {
+        if self.stack_need <= INLINE_STACK {
+            self.any(ray, spheres, &mut [0; INLINE_STACK])
+        } else {
+            self.any(ray, spheres, &mut vec![0; self.stack_need])
+        }
+    }
+
+    /// Every primitive tested with the same tests as traversal: the reference for it.
+    pub(crate) fn brute_force(&self, ray: &Ray, spheres: &[Sphere]) -> Option<(f32, Prim)> {
+        let r = RayData::new(ray);
+        let mut best = ray.t_max;
+        let mut hit = None;
+        for (i, s) in spheres.iter().enumerate() {
+            if let Some(t) = s.intersect(&Ray {
+                t_max: best,
+                ..*ray
+            }) {
+                best = t;
+                hit = Some(Prim::Sphere(i as u32));
+            }
+        }
+        for b in 0..self.tris.len() {
+            self.leaf_block(&r, b, &mut best, &mut hit);
+        }
+        hit.map(|p| (best, p))
+    }
+
+    #[inline(always)]
+    fn leaf_block(&self, r: &RayData, b: usize, best: &mut f32, hit: &mut Option<Prim>) {
+        let (mut m, t) = r.tri4(&self.tris[b], *best);
+        while m != 0 {
+            let l = m.trailing_zeros() as usize;
+            m &= m - 1;
+            if t[l] < *best {
+                *best = t[l];
+                *hit = Some(Prim::Triangle(self.ids[b][l]));
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn leaf(
+        &self,
+        r: &RayData,
+        ray: &Ray,
+        spheres: &[Sphere],
+        c: u32,
+        best: &mut f32,
+        hit: &mut Option<Prim>,
+    ) {
+        if c & SPHERE != 0 {
+            let i = c & !(LEAF | SPHERE);
+            if let Some(t) = spheres[i as usize].intersect(&Ray {
+                t_max: *best,
+                ..*ray
+            }) {
+                *best = t;
+                *hit = Some(Prim::Sphere(i));
+            }
+        } else {
+            let first = (c & FIRST_MASK) as usize;
+            let n = ((c & !LEAF) >> COUNT_SHIFT) as usize;
+            for b in first..first + n {
+                self.leaf_block(r, b, best, hit);
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn closest(&self, ray: &Ray, spheres: &[Sphere], stack: &mut [Entry]) -> Option<(f32, Prim)> {
+        let r = RayData::new(ray);
+        let mut best = ray.t_max;
+        let mut hit = None;
+        let mut sp = 0;
+        let mut cur = self.root;
+        loop {
+            if cur & LEAF == 0 {
+                let n = &self.nodes[cur as usize];
+                let (mask, tn) = r.node(n, best);
+                if mask != 0 {
+                    if mask & (mask - 1) == 0 {
+                        cur = n.child[mask.trailing_zeros() as usize];
+                        continue;
+                    }
+                    // Visit the nearest child first; push the others far to near
+                    // (Wald et al. 2008, "Getting rid of packets", ordered traversal).
+                    let tn = tn.to_array();
+                    let mut c = [(0u32, 0f32); 4];
+                    let mut k = 0;
+                    let mut m = mask;
+                    while m != 0 {
+                        let i = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let e = (n.child[i], tn[i]);
+                        // Insertion sort, farthest first.
+                        let mut j = k;
+                        while j > 0 && c[j - 1].1 < e.1 {
+                            c[j] = c[j - 1];
+                            j -= 1;
+                        }
+                        c[j] = e;
+                        k += 1;
+                    }
+                    stack[sp..sp + k - 1].copy_from_slice(&c[..k - 1]);
+                    sp += k - 1;
+                    cur = c[k - 1].0;
+                    continue;
+                }
+            } else {
+                self.leaf(&r, ray, spheres, cur, &mut best, &mut hit);
+            }
+            // Pop the next entry the ray still reaches before its closest hit so far.
+            let limit = best * robust();
+            loop {
+                if sp == 0 {
+                    return hit.map(|p| (best, p));
+                }
+                sp -= 1;
+                if stack[sp].1 <= limit {
+                    cur = stack[sp].0;
+                    break;
+                }
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn any(&self, ray: &Ray, spheres: &[Sphere], stack: &mut [u32]) -> bool {
+        let r = RayData::new(ray);
+        let mut sp = 0;
+        let mut cur = self.root;
+        loop {
+            if cur & LEAF == 0 {
+                let n = &self.nodes[cur as usize];
+                let (mut mask, _) = r.node(n, ray.t_max);
+                if mask != 0 {
+                    cur = n.child[mask.trailing_zeros() as usize];
+                    mask &= mask - 1;
+                    while mask != 0 {
+                        stack[sp] = n.child[mask.trailing_zeros() as usize];
+                        sp += 1;
+                        mask &= mask - 1;
+                    }
+                    continue;
+                }
+            } else {
+                let mut best = ray.t_max;
+                let mut hit = None;
+                self.leaf(&r, ray, spheres, cur, &mut best, &mut hit);
+                if hit.is_some() {
+                    return true;
+                }
+            }
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            cur = stack[sp];
+        }
+    }
+}
+
+struct Builder<'a> {
+    bvh2: &'a Bvh2,
+    /// Primitives `0..n_tri` are triangles, the rest spheres.
+    n_tri: u32,
+    mesh: &'a TriMesh,
+    /// Primitives under each Bvh2 node.
+    count: Vec<u32>,
+    has_sphere: Vec<bool>,
+    out: Bvh4,
+}
+
+impl Builder<'_> {
+    fn stats(&mut self, ni: usize) {
+        let n = self.bvh2.nodes[ni];
+        if n.prim_count > 0 {
+            let prims = &self.bvh2.primitive_indices
+                [n.first_index as usize..(n.first_index + n.prim_count) as usize];
+            self.count[ni] = n.prim_count;
+            self.has_sphere[ni] = prims.iter().any(|&p| p >= self.n_tri);
+        } else {
+            let (l, r) = (n.first_index as usize, n.first_index as usize + 1);
+            self.stats(l);
+            self.stats(r);
+            self.count[ni] = self.count[l] + self.count[r];
+            self.has_sphere[ni] = self.has_sphere[l] || self.has_sphere[r];
+        }
+    }
+
+    /// A subtree becomes one leaf: a lone sphere, or few enough triangles.
+    fn is_leaf(&self, ni: usize) -> bool {
+        let n = &self.bvh2.nodes[ni];
+        (n.prim_count > 0 && self.count[ni] == 1)
+            || (!self.has_sphere[ni] && self.count[ni] <= LEAF_MAX)
+    }
+
+    fn prims(&self, ni: usize, out: &mut Vec<u32>) {
+        let n = self.bvh2.nodes[ni];
+        if n.prim_count > 0 {
+            out.extend_from_slice(
+                &self.bvh2.primitive_indices
+                    [n.first_index as usize..(n.first_index + n.prim_count) as usize],
+            );
+        } else {
+            self.prims(n.first_index as usize, out);
+            self.prims(n.first_index as usize + 1, out);
+        }
+    }
+
+    /// Emits the subtree under Bvh2 node `ni`; returns its reference and depth in nodes.
+    fn emit(&mut self, ni: usize) -> (u32, usize) {
+        if self.is_leaf(ni) {
+            let mut prims = Vec::new();
+            self.prims(ni, &mut prims);
+            if prims[0] >= self.n_tri {
+                return (LEAF | SPHERE | (prims[0] - self.n_tri), 0);
+            }
+            let first = self.out.tris.len() as u32;
+            for group in prims.chunks(4) {
+                let mut tri = Tri4 {
+                    v: [[[0.0; 4]; 3]; 3],
+                };
+                let mut ids = [0; 4];
+                for l in 0..4 {
+                    let id = group[l.min(group.len() - 1)];
+                    ids[l] = id;
+                    for (j, v) in self.mesh.vertices(id as usize).iter().enumerate() {
+                        for a in 0..3 {
+                            tri.v[j][a][l] = v[a];
+                        }
+                    }
+                }
+                self.out.tris.push(tri);
+                self.out.ids.push(ids);
+            }
+            let blocks = self.out.tris.len() as u32 - first;
+            assert!(
+                first <= FIRST_MASK,
+                "too many triangles for the BVH4 leaf encoding"
+            );
+            return (LEAF | (blocks << COUNT_SHIFT) | first, 0);
+        }
+        // Open the largest child until four (the usual BVH2 -> BVH4 collapse by surface area,
+        // Wald et al. 2008 "Getting rid of packets" §3).
+        let first = self.bvh2.nodes[ni].first_index as usize;
+        let mut kids = vec![first, first + 1];
+        while kids.len() < 4 {
+            let open = kids
+                .iter()
+                .enumerate()
+                .filter(|(_, k)| !self.is_leaf(**k) && self.bvh2.nodes[**k].prim_count == 0)
+                .max_by(|a, b| {
+                    let area = |k: usize| self.bvh2.nodes[k].aabb().half_area();
+                    area(*a.1).total_cmp(&area(*b.1))
+                })
+                .map(|(i, _)| i);
+            let Some(i) = open else { break };
+            let k = self.bvh2.nodes[kids[i]].first_index as usize;
+            kids[i] = k;
+            kids.push(k + 1);
+        }
+        let idx = self.out.nodes.len();
+        self.out.nodes.push(Node4 {
+            b: [
+                [f32::INFINITY; 4],
+                [f32::NEG_INFINITY; 4],
+                [f32::INFINITY; 4],
+                [f32::NEG_INFINITY; 4],
+                [f32::INFINITY; 4],
+                [f32::NEG_INFINITY; 4],
+            ],
+            child: [EMPTY; 4],
+        });
+        let mut depth = 0;
+        for (slot, &k) in kids.iter().enumerate() {
+            let (c, d) = self.emit(k);
+            depth = depth.max(d);
+            let bb = self.bvh2.nodes[k].aabb();
+            let n = &mut self.out.nodes[idx];
+            for a in 0..3 {
+                n.b[2 * a][slot] = bb.min[a];
+                n.b[2 * a + 1][slot] = bb.max[a];
+            }
+            n.child[slot] = c;
+        }
+        (idx as u32, depth + 1)
+    }
+}
