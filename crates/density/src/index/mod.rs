@@ -87,7 +87,9 @@ impl Points {
 /// `bound` is the squared distance a point must not exceed to be offered: `r_max^2` until
 /// k points are seen, then the k-th smallest distance, so the search radius shrinks.
 struct Best<'a> {
+    /// `out[..len]` are the candidates; entries beyond are room to write into.
     out: &'a mut Vec<Neighbor>,
+    len: usize,
     k: usize,
     cap: usize,
     bound: f32,
@@ -95,9 +97,9 @@ struct Best<'a> {
 
 impl<'a> Best<'a> {
     fn new(out: &'a mut Vec<Neighbor>, k: usize, r2: f32) -> Best<'a> {
-        out.clear();
         Best {
             out,
+            len: 0,
             k,
             // First compaction as soon as k points are in, to start shrinking the radius.
             cap: k,
@@ -108,8 +110,40 @@ impl<'a> Best<'a> {
     /// Offer a point whose `d2 <= self.bound` (checked by the caller, on the hot path).
     #[inline]
     fn offer(&mut self, n: Neighbor) {
-        self.out.push(n);
-        if self.out.len() >= self.cap {
+        if self.out.len() <= self.len {
+            self.out.resize(2 * self.len + 16, n);
+        }
+        self.out[self.len] = n;
+        self.len += 1;
+        if self.len >= self.cap {
+            self.compact();
+        }
+    }
+
+    /// Offer a leaf's points (`d2s[j]` for `ids[j]`), those within the bound, by a
+    /// branch-free left-pack: every point is written, and kept by advancing the length (no
+    /// mispredicted branch per point; the SIMD "left-pack" idiom, e.g. Lemire's blog,
+    /// "Quickly pruning elements in SIMD vectors", 2017).
+    #[inline]
+    fn offer_leaf(&mut self, d2s: &[f32], ids: &[u32]) {
+        let m = d2s.len().min(ids.len());
+        if self.out.len() < self.len + m {
+            self.out
+                .resize(2 * self.len + 2 * m, Neighbor { index: 0, d2: 0.0 });
+        }
+        let bound = self.bound;
+        let dst = &mut self.out[self.len..self.len + m];
+        let mut kept = 0;
+        for j in 0..m {
+            // `kept <= j`: in bounds.
+            dst[kept.min(m - 1)] = Neighbor {
+                index: ids[j],
+                d2: d2s[j],
+            };
+            kept += (d2s[j] <= bound) as usize;
+        }
+        self.len += kept;
+        if self.len >= self.cap {
             self.compact();
         }
     }
@@ -119,15 +153,16 @@ impl<'a> Best<'a> {
     #[cold]
     fn compact(&mut self) {
         let k = self.k;
-        self.out.select_nth_unstable_by_key(k - 1, |n| n.key());
-        self.out.truncate(k);
+        self.out[..self.len].select_nth_unstable_by_key(k - 1, |n| n.key());
+        self.len = k;
         self.bound = self.out[k - 1].d2;
         self.cap = k.saturating_mul(2).max(k + 16);
     }
 
-    /// Keep the k smallest, unsorted.
+    /// Keep the k smallest, unsorted, in `out` (truncated to them).
     fn select(&mut self) {
-        if self.out.len() > self.k {
+        self.out.truncate(self.len);
+        if self.len > self.k {
             self.out.select_nth_unstable_by_key(self.k - 1, |n| n.key());
             self.out.truncate(self.k);
         }
@@ -135,7 +170,7 @@ impl<'a> Best<'a> {
 
     fn finish(mut self) {
         self.select();
-        self.out.sort_unstable_by_key(|n| n.key());
+        sort_by_key(self.out);
     }
 }
 
@@ -201,6 +236,48 @@ fn keep_k_smallest(out: &mut Vec<Neighbor>, k: usize) {
         len += (n.key() <= kth) as usize;
     }
     out.truncate(len);
+}
+
+/// Sort by `(d2, index)`: a bucket sort on d2 (monotone buckets over [0, max d2], about two
+/// points per bucket), then each bucket sorted by the full key. Near a surface or in a
+/// volume, d2 of the nearest points is spread fairly evenly, so buckets stay small and the
+/// sort is a few linear passes instead of comparison sorting's log k (Knuth, TAOCP vol. 3,
+/// §5.2.5, "sorting by distribution"; the buckets the "MSD" radix pass would make).
+pub(crate) fn sort_by_key(out: &mut Vec<Neighbor>) {
+    const MAX_BUCKETS: usize = 1024;
+    let m = out.len();
+    let hi = out.iter().fold(0f32, |a, n| a.max(n.d2));
+    let nb = (m / 2).clamp(1, MAX_BUCKETS);
+    let scale = nb as f32 / hi;
+    if m <= 32 || !(scale.is_finite() && scale > 0.0) {
+        out.sort_unstable_by_key(|n| n.key());
+        return;
+    }
+    // Float to int saturates, and the min keeps d2 == hi in the last bucket: monotone.
+    let bucket = |d2: f32| ((d2 * scale) as usize).min(nb - 1);
+    let mut start = [0u32; MAX_BUCKETS + 1];
+    for n in out.iter() {
+        start[bucket(n.d2) + 1] += 1;
+    }
+    for b in 0..nb {
+        start[b + 1] += start[b];
+    }
+    out.resize(2 * m, Neighbor { index: 0, d2: 0.0 });
+    let (src, dst) = out.split_at_mut(m);
+    let mut next = start;
+    for &n in src.iter() {
+        let b = bucket(n.d2);
+        dst[next[b] as usize] = n;
+        next[b] += 1;
+    }
+    for b in 0..nb {
+        let s = &mut dst[start[b] as usize..start[b + 1] as usize];
+        if s.len() > 1 {
+            s.sort_unstable_by_key(|n| n.key());
+        }
+    }
+    src.copy_from_slice(dst);
+    out.truncate(m);
 }
 
 /// The hinted answer of a back-end without a radius-first search: its exact k-NN, put in
