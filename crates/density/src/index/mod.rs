@@ -170,7 +170,7 @@ impl<'a> Best<'a> {
 
     fn finish(mut self) {
         self.select();
-        sort_by_key(self.out);
+        self.out.sort_unstable_by_key(|n| n.key());
     }
 }
 
@@ -236,48 +236,6 @@ fn keep_k_smallest(out: &mut Vec<Neighbor>, k: usize) {
         len += (n.key() <= kth) as usize;
     }
     out.truncate(len);
-}
-
-/// Sort by `(d2, index)`: a bucket sort on d2 (monotone buckets over [0, max d2], about two
-/// points per bucket), then each bucket sorted by the full key. Near a surface or in a
-/// volume, d2 of the nearest points is spread fairly evenly, so buckets stay small and the
-/// sort is a few linear passes instead of comparison sorting's log k (Knuth, TAOCP vol. 3,
-/// §5.2.5, "sorting by distribution"; the buckets the "MSD" radix pass would make).
-pub(crate) fn sort_by_key(out: &mut Vec<Neighbor>) {
-    const MAX_BUCKETS: usize = 1024;
-    let m = out.len();
-    let hi = out.iter().fold(0f32, |a, n| a.max(n.d2));
-    let nb = (m / 2).clamp(1, MAX_BUCKETS);
-    let scale = nb as f32 / hi;
-    if m <= 32 || !(scale.is_finite() && scale > 0.0) {
-        out.sort_unstable_by_key(|n| n.key());
-        return;
-    }
-    // Float to int saturates, and the min keeps d2 == hi in the last bucket: monotone.
-    let bucket = |d2: f32| ((d2 * scale) as usize).min(nb - 1);
-    let mut start = [0u32; MAX_BUCKETS + 1];
-    for n in out.iter() {
-        start[bucket(n.d2) + 1] += 1;
-    }
-    for b in 0..nb {
-        start[b + 1] += start[b];
-    }
-    out.resize(2 * m, Neighbor { index: 0, d2: 0.0 });
-    let (src, dst) = out.split_at_mut(m);
-    let mut next = start;
-    for &n in src.iter() {
-        let b = bucket(n.d2);
-        dst[next[b] as usize] = n;
-        next[b] += 1;
-    }
-    for b in 0..nb {
-        let s = &mut dst[start[b] as usize..start[b + 1] as usize];
-        if s.len() > 1 {
-            s.sort_unstable_by_key(|n| n.key());
-        }
-    }
-    src.copy_from_slice(dst);
-    out.truncate(m);
 }
 
 /// The hinted answer of a back-end without a radius-first search: its exact k-NN, put in
