@@ -30,8 +30,8 @@ pub struct KdTree {
     identity: bool,
 }
 
-/// Most points per leaf. 32 beat 16 and 64 at 1M photons for k = 50..1000
-/// (`bench::bench_knn`, release, one thread).
+/// Most points per leaf: 32, kiddo's bucket size too (not yet tuned for this tree; the
+/// in-place tree it replaced had measured 16 best).
 const LEAF: usize = 32;
 
 /// The depth at which every leaf holds at most `LEAF` of `n` points (sizes at one depth
