@@ -16,6 +16,9 @@ const RUNS: usize = 3;
 #[derive(Clone, Copy, Debug)]
 pub struct KnnBench {
     pub index: IndexKind,
+    /// The index's name, or "kiddo_raw": kiddo's own `nearest_n` (sorted by distance, no
+    /// tie rule), the fairest figure for kiddo.
+    pub name: &'static str,
     pub photons: usize,
     pub k: usize,
     /// Queries actually timed (brute force gets fewer: it is O(n) per query).
@@ -37,7 +40,9 @@ pub fn point_on_unit_cube(rng: &mut Rng) -> [f32; 3] {
     p
 }
 
-/// Benchmark every index over `photons` points for each k in `ks`.
+/// Benchmark every index over `photons` points for each k in `ks`, and kiddo's own
+/// `nearest_n`. Per k, the runs are interleaved (one pass of each, `RUNS` times), so a
+/// change of machine load hits all of them alike and their ratios hold.
 pub fn bench_knn(photons: usize, ks: &[usize], queries: usize, seed: u64) -> Vec<KnnBench> {
     let mut rng = Rng::for_index(seed, 0);
     let points: Vec<[f32; 3]> = (0..photons).map(|_| point_on_unit_cube(&mut rng)).collect();
@@ -45,44 +50,71 @@ pub fn bench_knn(photons: usize, ks: &[usize], queries: usize, seed: u64) -> Vec
     let qs: Vec<Vec3> = (0..queries)
         .map(|_| Vec3::from(point_on_unit_cube(&mut qrng)))
         .collect();
+    let built: Vec<(Index, f64)> = IndexKind::ALL
+        .iter()
+        .map(|&kind| {
+            let t0 = Instant::now();
+            let index = Index::build(kind, &points);
+            (index, t0.elapsed().as_secs_f64())
+        })
+        .collect();
+    // (index, kiddo's own query?)
+    let mut runs: Vec<(&Index, f64, bool)> = built.iter().map(|(i, t)| (i, *t, false)).collect();
+    if let Some((ki, t)) = built.iter().find(|(i, _)| i.kind() == IndexKind::Kiddo) {
+        runs.insert(2, (ki, *t, true));
+    }
     let mut out = Vec::new();
-    for kind in IndexKind::ALL {
-        let t0 = Instant::now();
-        let index = Index::build(kind, &points);
-        let build_s = t0.elapsed().as_secs_f64();
-        // Brute force: cap the work at ~2e8 distance evaluations per pass.
-        let nq = if kind == IndexKind::Brute {
-            (200_000_000 / photons.max(1)).clamp(10, queries.max(10))
-        } else {
-            queries
+    for &k in ks {
+        let mut scratch: Vec<Neighbor> = Vec::with_capacity(k + 1);
+        let mut times = vec![Vec::new(); runs.len()];
+        for _ in 0..RUNS {
+            for (&(index, _, raw), t) in runs.iter().zip(times.iter_mut()) {
+                let nq = queries_for(index.kind(), photons, qs.len());
+                let t0 = Instant::now();
+                let mut acc = 0usize;
+                for &q in &qs[..nq] {
+                    acc += match (raw, index) {
+                        (true, Index::Kiddo(kd)) => kd.nearest_n_raw(q, k),
+                        _ => {
+                            index.knn(q, k, f32::INFINITY, &mut scratch);
+                            scratch.len()
+                        }
+                    };
+                }
+                black_box(acc);
+                t.push(t0.elapsed().as_secs_f64());
+            }
         }
-        .min(qs.len());
-        for &k in ks {
-            let mut scratch: Vec<Neighbor> = Vec::with_capacity(k + 1);
-            let mut times: Vec<f64> = (0..RUNS)
-                .map(|_| {
-                    let t = Instant::now();
-                    let mut acc = 0usize;
-                    for &q in &qs[..nq] {
-                        index.knn(q, k, f32::INFINITY, &mut scratch);
-                        acc += scratch.len();
-                    }
-                    black_box(acc);
-                    t.elapsed().as_secs_f64()
-                })
-                .collect();
-            times.sort_by(f64::total_cmp);
+        for (&(index, build_s, raw), mut t) in runs.iter().zip(times) {
+            t.sort_by(f64::total_cmp);
+            let nq = queries_for(index.kind(), photons, qs.len());
             out.push(KnnBench {
-                index: kind,
+                index: index.kind(),
+                name: if raw {
+                    "kiddo_raw"
+                } else {
+                    index.kind().name()
+                },
                 photons,
                 k,
                 queries: nq,
-                queries_per_s: nq as f64 / times[RUNS / 2].max(1e-12),
+                queries_per_s: nq as f64 / t[RUNS / 2].max(1e-12),
                 build_s,
             });
         }
     }
     out
+}
+
+/// Queries timed per pass: all of them, but brute force is capped at ~2e8 distance
+/// evaluations per pass.
+fn queries_for(kind: IndexKind, photons: usize, queries: usize) -> usize {
+    if kind == IndexKind::Brute {
+        (200_000_000 / photons.max(1)).clamp(10, queries.max(10))
+    } else {
+        queries
+    }
+    .min(queries)
 }
 
 /// One row of [`bench_coherent`]: queries/s of the plain k-NN search and of the hinted

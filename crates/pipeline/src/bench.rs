@@ -372,11 +372,8 @@ pub fn knn(photons: usize, queries: usize) -> Result<(), String> {
     println!("{photons} photons on the unit cube's faces, {queries} queries, 1 thread");
     for r in density::bench::bench_knn(photons, &[50, 250, 1000], queries, 7) {
         println!(
-            "{:>8} k = {:4}: {:10.0} queries/s (build {:.3} s)",
-            r.index.name(),
-            r.k,
-            r.queries_per_s,
-            r.build_s
+            "{:>9} k = {:4}: {:10.0} queries/s (build {:.3} s)",
+            r.name, r.k, r.queries_per_s, r.build_s
         );
     }
     let res = 128;

@@ -22,10 +22,11 @@ impl Brute {
     }
 
     pub fn knn(&self, q: Vec3, k: usize, r_max: f32, out: &mut Vec<Neighbor>) {
-        let mut best = Best::new(out, k, radius2(r_max));
         if k == 0 {
+            out.clear();
             return;
         }
+        let mut best = Best::new(out, k, radius2(r_max));
         let q = q.to_array();
         for i in 0..self.pts.len() {
             let d2 = dist2(self.pts.get(i), q);

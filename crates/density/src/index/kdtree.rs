@@ -4,29 +4,60 @@
 use super::{Best, KnnHint, Neighbor, Points, dist2, keep_k_smallest, radius2};
 use glam::Vec3;
 
-/// Our kd-tree, built in place (Jensen 2001, §6.3 "balanced kd-tree"; like Tungsten's
-/// photon map, without node structs): the positions are permuted so that every index range
-/// `[lo, hi)` longer than a leaf is split at its median `mid = (lo + hi) / 2` along the
-/// axis of largest extent; `[lo, mid)` lies at or below `pos[mid][axis]`, `[mid + 1, hi)`
-/// at or above, and `pos[mid]` is the node's own point. No child pointers: a node *is* an
-/// index range, and its split axis is one byte stored at `axis[mid]`.
+/// Our kd-tree, a bucket tree built in place (Friedman, Bentley, Finkel 1977, "An
+/// Algorithm for Finding Best Matches in Logarithmic Expected Time": points only in
+/// buckets; median splits as in Jensen 2001, §6.3): the positions are permuted so that
+/// every node is an index range `[lo, hi)`, split at `mid = lo + (hi - lo) / 2` along the
+/// axis of largest extent into `[lo, mid)`, at or below `split`, and `[mid, hi)`, at or
+/// above it, down to a depth where every range has at most `LEAF` points. All leaves are at
+/// that one depth, so the nodes form a complete binary tree numbered in heap order (node
+/// `i`'s children are `2i + 1`, `2i + 2`), and a node is its split value and axis, two
+/// small arrays that stay in cache (at 1M points, 32k nodes, 160 kB), while the points are
+/// read a leaf at a time, contiguously.
 ///
-/// Hot/cold split: the query reads the positions (and `axis`) only; `ids` (the original
-/// index of each slot) is read when a point enters the result buffer.
+/// Hot/cold split: the search reads the splits and positions; `ids` (the original index
+/// of each slot) is read when a leaf's points are offered to the result buffer.
 #[derive(Clone, Debug)]
 pub struct KdTree {
     /// Positions by slot.
     pts: Points,
     ids: Vec<u32>,
+    /// Per internal node, in heap order.
+    split: Vec<f32>,
     axis: Vec<u8>,
     /// `ids[i] == i` for every slot (after [`KdTree::relabel_by_slot`]): results need no
     /// relabelling.
     identity: bool,
 }
 
-/// Ranges of at most this many points are scanned linearly. 16 beat 8 and 32 at 1M
-/// photons for k = 50..1000 (`bench::bench_knn`, release, one thread).
-const LEAF: usize = 16;
+/// Most points per leaf: 32, kiddo's bucket size too (not yet tuned for this tree; the
+/// in-place tree it replaced had measured 16 best).
+const LEAF: usize = 32;
+
+/// The depth at which every leaf holds at most `LEAF` of `n` points (sizes at one depth
+/// differ by at most one, the largest being ceil(n / 2^depth)).
+fn depth_for(n: usize) -> u32 {
+    let mut d = 0;
+    while n.div_ceil(1 << d) > LEAF {
+        d += 1;
+    }
+    d
+}
+
+/// One leaf's squared distances, a loop over the SoA rows that vectorises.
+#[inline]
+fn leaf_d2(pts: &Points, lo: usize, hi: usize, q: [f32; 3]) -> [f32; LEAF] {
+    let mut d2s = [f32::INFINITY; LEAF];
+    let (xs, ys, zs) = (
+        &pts.xyz[0][lo..hi],
+        &pts.xyz[1][lo..hi],
+        &pts.xyz[2][lo..hi],
+    );
+    for (j, d2) in d2s[..hi - lo].iter_mut().enumerate() {
+        *d2 = dist2([xs[j], ys[j], zs[j]], q);
+    }
+    d2s
+}
 
 impl KdTree {
     /// Build over `points`; results index into `points`. O(n log n): one bounding box and
@@ -38,10 +69,13 @@ impl KdTree {
             .enumerate()
             .map(|(i, &p)| (p, i as u32))
             .collect();
-        let mut axis = vec![0u8; points.len()];
-        let mut stack = vec![(0usize, points.len())];
-        while let Some((lo, hi)) = stack.pop() {
-            if hi - lo <= LEAF {
+        let depth = depth_for(points.len());
+        let nodes = (1usize << depth) - 1;
+        let mut split = vec![0f32; nodes];
+        let mut axis = vec![0u8; nodes];
+        let mut stack = vec![(0usize, 0usize, points.len())];
+        while let Some((node, lo, hi)) = stack.pop() {
+            if node >= nodes {
                 continue;
             }
             let (mut min, mut max) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
@@ -60,12 +94,14 @@ impl KdTree {
                 2
             };
             let mid = lo + (hi - lo) / 2;
-            items[lo..hi].select_nth_unstable_by(mid - lo, |x, y| x.0[a].total_cmp(&y.0[a]));
-            axis[mid] = a as u8;
-            // The median stays put as the node's own point; the children exclude it, so
-            // their partitions never move it and `pos[mid]` keeps the split value.
-            stack.push((lo, mid));
-            stack.push((mid + 1, hi));
+            if mid < hi {
+                items[lo..hi].select_nth_unstable_by(mid - lo, |x, y| x.0[a].total_cmp(&y.0[a]));
+            }
+            // The right half's smallest coordinate: the left half lies at or below it.
+            split[node] = items.get(mid).map_or(0.0, |it| it.0[a]);
+            axis[node] = a as u8;
+            stack.push((2 * node + 1, lo, mid));
+            stack.push((2 * node + 2, mid, hi));
         }
         let pts = Points {
             xyz: [0, 1, 2].map(|a| items.iter().map(|(p, _)| p[a]).collect()),
@@ -74,6 +110,7 @@ impl KdTree {
         KdTree {
             pts,
             ids,
+            split,
             axis,
             identity: false,
         }
@@ -90,11 +127,6 @@ impl KdTree {
     /// Positions by slot.
     pub(crate) fn points(&self) -> &Points {
         &self.pts
-    }
-
-    #[inline]
-    fn pos(&self, i: usize) -> [f32; 3] {
-        self.pts.get(i)
     }
 
     /// Original index of each tree slot: `order()[slot]`. A caller that reorders its own
@@ -124,140 +156,121 @@ impl KdTree {
         if best.k == 0 || self.is_empty() {
             return;
         }
-        // (lo, hi, per-axis distance from q to the range's cell, lower bound on d2).
-        // Depth <= 32, at most two entries per level.
-        let mut stack = [(0u32, 0u32, [0f32; 3], 0f32); 72];
-        stack[0] = (0, self.len() as u32, [0.0; 3], 0.0);
+        let nodes = self.split.len();
+        // (node, lo, hi, per-axis distance from q to the node's cell, lower bound on d2).
+        // Depth <= 32, one entry left behind per level.
+        let mut stack = [(0u32, 0u32, 0u32, [0f32; 3], 0f32); 40];
+        stack[0] = (0, 0, self.len() as u32, [0.0; 3], 0.0);
         let mut sp = 1;
         while sp > 0 {
             sp -= 1;
-            let (lo, hi, off, dmin) = stack[sp];
+            let (mut node, lo, hi, off, dmin) = stack[sp];
             // Strictly greater: a point at exactly the k-th distance with a smaller index
             // still wins its tie.
             if dmin > best.bound {
                 continue;
             }
-            let (lo, hi) = (lo as usize, hi as usize);
-            if hi - lo <= LEAF {
-                for i in lo..hi {
-                    let d2 = dist2(self.pos(i), q);
-                    if d2 <= best.bound {
-                        best.offer(Neighbor {
-                            index: self.ids[i],
-                            d2,
-                        });
-                    }
+            let (mut lo, mut hi) = (lo as usize, hi as usize);
+            // Down to the near leaf, leaving the far children behind.
+            while (node as usize) < nodes {
+                let mid = lo + (hi - lo) / 2;
+                let a = self.axis[node as usize] as usize;
+                let diff = q[a] - self.split[node as usize];
+                // The far cell's distance from q (Arya & Mount 1993, "Algorithms for fast
+                // vector quantization": incremental distance to the cell, tighter than the
+                // plane alone). Summed like `dist2` from per-axis offsets that never exceed
+                // |q - p| for a point p in the cell, and f32 rounding is monotone, so the
+                // bound never prunes a true neighbour.
+                let mut far_off = off;
+                far_off[a] = diff.abs().max(off[a]);
+                let dfar = dist2(far_off, [0.0; 3]);
+                let (near, far) = if diff < 0.0 {
+                    ((2 * node + 1, lo, mid), (2 * node + 2, mid, hi))
+                } else {
+                    ((2 * node + 2, mid, hi), (2 * node + 1, lo, mid))
+                };
+                if dfar <= best.bound {
+                    stack[sp] = (far.0, far.1 as u32, far.2 as u32, far_off, dfar);
+                    sp += 1;
                 }
-                continue;
+                (node, lo, hi) = near;
             }
-            let mid = lo + (hi - lo) / 2;
-            let split = self.pos(mid);
-            let d2 = dist2(split, q);
-            if d2 <= best.bound {
-                best.offer(Neighbor {
-                    index: self.ids[mid],
-                    d2,
-                });
-            }
-            let a = self.axis[mid] as usize;
-            let diff = q[a] - split[a];
-            // The far cell's distance from q (Arya & Mount 1993, "Algorithms for fast
-            // vector quantization": incremental distance to the cell, tighter than the
-            // plane alone). Summed like `dist2` from per-axis offsets that never exceed
-            // |q - p| for a point p in the cell, and f32 rounding is monotone, so the
-            // bound never prunes a true neighbour.
-            let mut far_off = off;
-            far_off[a] = diff.abs().max(off[a]);
-            let dfar = dist2(far_off, [0.0; 3]);
-            let (near, far) = if diff < 0.0 {
-                ((lo, mid), (mid + 1, hi))
-            } else {
-                ((mid + 1, hi), (lo, mid))
-            };
-            stack[sp] = (far.0 as u32, far.1 as u32, far_off, dfar);
-            stack[sp + 1] = (near.0 as u32, near.1 as u32, off, dmin);
-            sp += 2;
+            // The leaf: distances, then a branch-free left-pack of those within the bound
+            // into the buffer (every point is written, kept by advancing the length; the
+            // SIMD "left-pack" idiom, e.g. Lemire's blog, "Quickly pruning elements in SIMD
+            // vectors", 2017).
+            let d2s = leaf_d2(&self.pts, lo, hi, q);
+            best.offer_leaf(&d2s[..hi - lo], &self.ids[lo..hi]);
         }
     }
 
     /// Fixed-radius search: every point with `d2 <= r2` as `(slot, d2)`, in slot order (an
-    /// in-order walk: left range, node point, right range), so the output order depends on
-    /// the set alone. Gives up (returns false, `out` partial) once more than `cap` are in.
-    /// `out`'s old entries are overwritten, not cleared first: its length is room to write
-    /// into without zero-filling it again (a resize writes every new entry).
+    /// in-order walk of the leaves), so the output order depends on the set alone. Gives up
+    /// (returns false, `out` partial) once more than `cap` are in. `out`'s old entries are
+    /// overwritten, not cleared first: its length is room to write into without
+    /// zero-filling it again (a resize writes every new entry).
     fn gather(&self, q: [f32; 3], r2: f32, cap: usize, out: &mut Vec<Neighbor>) -> bool {
         if self.is_empty() {
             out.clear();
             return true;
         }
+        let nodes = self.split.len();
         let mut len = 0;
-        // (lo, hi, per-axis distance from q to the range's cell). Each level leaves at most
-        // two entries (node point, right range) behind; depth <= 32.
-        let mut stack = [(0u32, 0u32, [0f32; 3]); 100];
-        stack[0] = (0, self.len() as u32, [0.0; 3]);
+        // (node, lo, hi, per-axis distance from q to the node's cell). Depth <= 32, one
+        // entry left behind per level.
+        let mut stack = [(0u32, 0u32, 0u32, [0f32; 3]); 40];
+        stack[0] = (0, 0, self.len() as u32, [0.0; 3]);
         let mut sp = 1;
         while sp > 0 {
             sp -= 1;
-            let (lo, hi, off) = stack[sp];
-            let (lo, hi) = (lo as usize, hi as usize);
-            if hi - lo <= LEAF {
-                // Distances first (a loop over the SoA rows that vectorises), then a
-                // branch-free stream compaction: every point is written, and kept by advancing
-                // `len` only if inside (no mispredicted branch per point; the usual SIMD
-                // "left-pack" idiom, e.g. Lemire's blog, "Quickly pruning elements in SIMD
-                // vectors", 2017).
-                let m = hi - lo;
-                let mut d2s = [0f32; LEAF];
-                let (xs, ys, zs) = (
-                    &self.pts.xyz[0][lo..hi],
-                    &self.pts.xyz[1][lo..hi],
-                    &self.pts.xyz[2][lo..hi],
-                );
-                for (j, d2) in d2s[..m].iter_mut().enumerate() {
-                    *d2 = dist2([xs[j], ys[j], zs[j]], q);
+            let (mut node, lo, hi, mut off) = stack[sp];
+            let (mut lo, mut hi) = (lo as usize, hi as usize);
+            // Down the left-most child in reach, leaving the right children behind, so
+            // leaves come out in slot order.
+            while (node as usize) < nodes {
+                let mid = lo + (hi - lo) / 2;
+                let a = self.axis[node as usize] as usize;
+                let diff = q[a] - self.split[node as usize];
+                // As in `search` (Arya & Mount): the far side's cell distance.
+                let mut far_off = off;
+                far_off[a] = diff.abs().max(off[a]);
+                let far_in = dist2(far_off, [0.0; 3]) <= r2;
+                let (left, right) = if diff < 0.0 {
+                    (Some(off), far_in.then_some(far_off))
+                } else {
+                    (far_in.then_some(far_off), Some(off))
+                };
+                // The near side is always in reach.
+                match (left, right) {
+                    (Some(lo_off), Some(ro)) => {
+                        stack[sp] = (2 * node + 2, mid as u32, hi as u32, ro);
+                        sp += 1;
+                        (node, hi, off) = (2 * node + 1, mid, lo_off);
+                    }
+                    (Some(lo_off), None) => (node, hi, off) = (2 * node + 1, mid, lo_off),
+                    (None, r) => (node, lo, off) = (2 * node + 2, mid, r.unwrap_or(off)),
                 }
-                if out.len() < len + LEAF {
-                    out.resize(2 * out.len() + LEAF, Neighbor { index: 0, d2: 0.0 });
-                }
-                // `kept <= j < LEAF`, so the mask never changes it; it lets the compiler drop
-                // the bounds check.
-                let dst = &mut out[len..len + LEAF];
-                let mut kept = 0;
-                for (j, &d2) in d2s[..m].iter().enumerate() {
-                    dst[kept & (LEAF - 1)] = Neighbor {
-                        index: (lo + j) as u32,
-                        d2,
-                    };
-                    kept += (d2 <= r2) as usize;
-                }
-                len += kept;
-                if len > cap {
-                    out.truncate(len);
-                    return false;
-                }
-                continue;
             }
-            let mid = lo + (hi - lo) / 2;
-            let a = self.axis[mid] as usize;
-            let diff = q[a] - self.pts.xyz[a][mid];
-            // As in `search` (Arya & Mount): the far side's cell distance.
-            let mut far_off = off;
-            far_off[a] = diff.abs().max(off[a]);
-            let far_in = dist2(far_off, [0.0; 3]) <= r2;
-            let (left, right) = if diff < 0.0 {
-                (Some(off), far_in.then_some(far_off))
-            } else {
-                (far_in.then_some(far_off), Some(off))
-            };
-            if let Some(o) = right {
-                stack[sp] = ((mid + 1) as u32, hi as u32, o);
-                sp += 1;
+            let m = hi - lo;
+            let d2s = leaf_d2(&self.pts, lo, hi, q);
+            if out.len() < len + LEAF {
+                out.resize(2 * out.len() + LEAF, Neighbor { index: 0, d2: 0.0 });
             }
-            stack[sp] = (mid as u32, (mid + 1) as u32, off);
-            sp += 1;
-            if let Some(o) = left {
-                stack[sp] = (lo as u32, mid as u32, o);
-                sp += 1;
+            // Branch-free left-pack (as in `search`). `kept <= j < LEAF`, so the mask
+            // never changes it; it lets the compiler drop the bounds check.
+            let dst = &mut out[len..len + LEAF];
+            let mut kept = 0;
+            for (j, &d2) in d2s[..m].iter().enumerate() {
+                dst[kept & (LEAF - 1)] = Neighbor {
+                    index: (lo + j) as u32,
+                    d2,
+                };
+                kept += (d2 <= r2) as usize;
+            }
+            len += kept;
+            if len > cap {
+                out.truncate(len);
+                return false;
             }
         }
         out.truncate(len);

@@ -65,6 +65,16 @@ impl Kiddo {
         out.truncate(k);
     }
 
+    /// kiddo's own k-NN as its documentation recommends (`nearest_n`, squared Euclidean,
+    /// sorted by distance), without our tie rule or distances: the honest baseline for
+    /// `bench::bench_knn`. Returns the number found.
+    pub fn nearest_n_raw(&self, q: Vec3, k: usize) -> usize {
+        match (&self.tree, NonZero::new(k)) {
+            (Some(tree), Some(k)) => tree.nearest_n::<SquaredEuclidean>(&q.to_array(), k).len(),
+            _ => 0,
+        }
+    }
+
     /// [`Kiddo::knn`] in index order; see [`super::KdTree::knn_hinted`].
     pub fn knn_hinted(
         &self,

@@ -87,7 +87,9 @@ impl Points {
 /// `bound` is the squared distance a point must not exceed to be offered: `r_max^2` until
 /// k points are seen, then the k-th smallest distance, so the search radius shrinks.
 struct Best<'a> {
+    /// `out[..len]` are the candidates; entries beyond are room to write into.
     out: &'a mut Vec<Neighbor>,
+    len: usize,
     k: usize,
     cap: usize,
     bound: f32,
@@ -95,9 +97,9 @@ struct Best<'a> {
 
 impl<'a> Best<'a> {
     fn new(out: &'a mut Vec<Neighbor>, k: usize, r2: f32) -> Best<'a> {
-        out.clear();
         Best {
             out,
+            len: 0,
             k,
             // First compaction as soon as k points are in, to start shrinking the radius.
             cap: k,
@@ -108,8 +110,40 @@ impl<'a> Best<'a> {
     /// Offer a point whose `d2 <= self.bound` (checked by the caller, on the hot path).
     #[inline]
     fn offer(&mut self, n: Neighbor) {
-        self.out.push(n);
-        if self.out.len() >= self.cap {
+        if self.out.len() <= self.len {
+            self.out.resize(2 * self.len + 16, n);
+        }
+        self.out[self.len] = n;
+        self.len += 1;
+        if self.len >= self.cap {
+            self.compact();
+        }
+    }
+
+    /// Offer a leaf's points (`d2s[j]` for `ids[j]`), those within the bound, by a
+    /// branch-free left-pack: every point is written, and kept by advancing the length (no
+    /// mispredicted branch per point; the SIMD "left-pack" idiom, e.g. Lemire's blog,
+    /// "Quickly pruning elements in SIMD vectors", 2017).
+    #[inline]
+    fn offer_leaf(&mut self, d2s: &[f32], ids: &[u32]) {
+        let m = d2s.len().min(ids.len());
+        if self.out.len() < self.len + m {
+            self.out
+                .resize(2 * self.len + 2 * m, Neighbor { index: 0, d2: 0.0 });
+        }
+        let bound = self.bound;
+        let dst = &mut self.out[self.len..self.len + m];
+        let mut kept = 0;
+        for j in 0..m {
+            // `kept <= j`: in bounds.
+            dst[kept.min(m - 1)] = Neighbor {
+                index: ids[j],
+                d2: d2s[j],
+            };
+            kept += (d2s[j] <= bound) as usize;
+        }
+        self.len += kept;
+        if self.len >= self.cap {
             self.compact();
         }
     }
@@ -119,15 +153,16 @@ impl<'a> Best<'a> {
     #[cold]
     fn compact(&mut self) {
         let k = self.k;
-        self.out.select_nth_unstable_by_key(k - 1, |n| n.key());
-        self.out.truncate(k);
+        self.out[..self.len].select_nth_unstable_by_key(k - 1, |n| n.key());
+        self.len = k;
         self.bound = self.out[k - 1].d2;
         self.cap = k.saturating_mul(2).max(k + 16);
     }
 
-    /// Keep the k smallest, unsorted.
+    /// Keep the k smallest, unsorted, in `out` (truncated to them).
     fn select(&mut self) {
-        if self.out.len() > self.k {
+        self.out.truncate(self.len);
+        if self.len > self.k {
             self.out.select_nth_unstable_by_key(self.k - 1, |n| n.key());
             self.out.truncate(self.k);
         }

@@ -114,6 +114,31 @@ each_index!(equals_brute_force_on_10k_photons, |kind: IndexKind| {
     );
 });
 
+// Large k over points on a coarse grid of the cube's faces: every distance is shared by
+// many points, so each compaction of the k-NN buffer and each leaf cut at the bound
+// lands in a tie that only the index settles. Sizes straddle a change of tree depth
+// (leaves of 32 and of 16-17 points).
+each_index!(large_k_with_ties_equals_brute_force, |kind: IndexKind| {
+    let mut out = Vec::new();
+    for n in [4095usize, 4097] {
+        let mut rng = Rng::new(n as u64);
+        let points: Vec<[f32; 3]> = (0..n)
+            .map(|_| crate::bench::point_on_unit_cube(&mut rng).map(|c| (c * 16.0).round() / 16.0))
+            .collect();
+        let index = Index::build(kind, &points);
+        for _ in 0..12 {
+            let q = Vec3::from(
+                crate::bench::point_on_unit_cube(&mut rng).map(|c| (c * 8.0).round() / 8.0),
+            );
+            for k in [31, 100, 1000] {
+                for r_max in [f32::INFINITY, 0.25] {
+                    check(&index, &points, q, k, r_max, &mut out);
+                }
+            }
+        }
+    }
+});
+
 each_index!(duplicates_all_at_one_point, |kind: IndexKind| {
     let points = vec![[0.25f32, -1.0, 3.0]; 1000];
     let index = Index::build(kind, &points);
