@@ -42,6 +42,11 @@ enum Cmd {
         /// closest-hit distances (inf = miss).
         #[arg(long, value_name = "DIR")]
         ray_dir: Option<PathBuf>,
+        /// `NAME=CMD`: a peer's single-thread ray benchmark run by `sh -c CMD`, alternating
+        /// with ours for `--runs` rounds; its `coherent`/`incoherent` lines' `X Mrays/s` are
+        /// read and the ratios printed (use `--ray-dir` with the rays the peer casts).
+        #[arg(long, value_name = "NAME=CMD")]
+        peer: Option<String>,
     },
     /// Photon paths/s on 1 and 2 threads, tracing only and through the pipeline to files.
     BenchPhotons {
@@ -426,7 +431,17 @@ fn run(cmd: Cmd) -> Result<(), String> {
             rays,
             compare,
             ray_dir,
-        } => pipeline::bench::rays(&scene, runs, rays, compare, ray_dir.as_deref()),
+            peer,
+        } => {
+            let peer = match &peer {
+                Some(p) => Some(
+                    p.split_once('=')
+                        .ok_or_else(|| format!("--peer {p}: expected NAME=CMD"))?,
+                ),
+                None => None,
+            };
+            pipeline::bench::rays(&scene, runs, rays, compare, ray_dir.as_deref(), peer)
+        }
         Cmd::Render {
             scene,
             method,

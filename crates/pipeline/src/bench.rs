@@ -14,6 +14,7 @@ pub fn rays(
     count: usize,
     compare: bool,
     ray_dir: Option<&Path>,
+    peer: Option<(&str, &str)>,
 ) -> Result<(), String> {
     if runs == 0 || count == 0 {
         return Err("--runs and --rays must be positive".into());
@@ -65,7 +66,8 @@ pub fn rays(
     if compare {
         kinds.push(BvhKind::CwBvh);
     }
-    for kind in kinds {
+    let mut ours_first: Vec<f64> = Vec::new();
+    for (k, kind) in kinds.into_iter().enumerate() {
         let t0 = Instant::now();
         let geo = Geometry::with_bvh(
             s.geometry.mesh().clone(),
@@ -75,6 +77,9 @@ pub fn rays(
         let build = t0.elapsed();
         for (name, rays, reference) in &sets {
             let (mrays, hits) = median_rate(&geo, rays, runs);
+            if k == 0 {
+                ours_first.push(mrays);
+            }
             println!(
                 "{name:>10}: {mrays:7.2} M rays/s  ({kind:?}, build {:.1} ms, {:.1}% hit)",
                 build.as_secs_f64() * 1e3,
@@ -92,7 +97,77 @@ pub fn rays(
             }
         }
     }
+    if let Some((name, command)) = peer {
+        peer_ratios(&s.geometry, &sets, runs, name, command)?;
+    }
     Ok(())
+}
+
+/// The peer and our default BVH in alternating rounds (peer, then ours, `runs` times), so
+/// both see the same machine load; medians of each and their ratio. The peer is a shell
+/// command printing lines with `coherent` or `incoherent` and a rate `X Mrays/s` (or
+/// `M rays/s`), one thread (e.g. Embree 4 through its Python bindings, pinned to one CPU).
+fn peer_ratios(
+    geometry: &Geometry,
+    sets: &[RaySet],
+    runs: usize,
+    name: &str,
+    command: &str,
+) -> Result<(), String> {
+    let geo = Geometry::with_bvh(
+        geometry.mesh().clone(),
+        geometry.spheres().to_vec(),
+        BvhKind::Bvh4,
+    );
+    let mut theirs: Vec<Vec<f64>> = vec![Vec::new(); sets.len()];
+    let mut ours: Vec<Vec<f64>> = vec![Vec::new(); sets.len()];
+    for _ in 0..runs {
+        let out = std::process::Command::new("sh")
+            .arg("-c")
+            .arg(command)
+            .output()
+            .map_err(|e| format!("peer {name}: {e}"))?;
+        if !out.status.success() {
+            return Err(format!("peer {name}: `{command}` failed ({})", out.status));
+        }
+        let text = String::from_utf8_lossy(&out.stdout);
+        for (i, (set, rays, _)) in sets.iter().enumerate() {
+            let rate = peer_rate(&text, set).ok_or_else(|| {
+                format!("peer {name}: no `{set} ... Mrays/s` line in its output")
+            })?;
+            theirs[i].push(rate);
+            ours[i].push(median_rate(&geo, rays, 1).0);
+        }
+    }
+    println!("against {name}, {runs} alternating rounds (medians, M rays/s):");
+    for (i, (set, _, _)) in sets.iter().enumerate() {
+        let (t, o) = (median(&mut theirs[i]), median(&mut ours[i]));
+        println!(
+            "{set:>10}: {name} {t:7.2}, photonflow {o:7.2}, ratio {:.2}x",
+            o / t
+        );
+    }
+    Ok(())
+}
+
+/// The rate on the first line that starts with `set` (after spaces) and holds `Mrays/s`.
+pub fn peer_rate(text: &str, set: &str) -> Option<f64> {
+    text.lines()
+        .filter(|l| {
+            let l = l.trim_start();
+            l.starts_with(set)
+                && !(set == "coherent" && l.starts_with("incoherent"))
+                && (l.contains("Mrays/s") || l.contains("M rays/s"))
+        })
+        .find_map(|l| {
+            let head = l.split("M rays/s").next()?.split("Mrays/s").next()?;
+            head.split_whitespace().last()?.parse::<f64>().ok()
+        })
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
 }
 
 /// A named ray set and, from ray files, the reference's closest-hit distances.

@@ -458,3 +458,15 @@ fn the_rim_mask_marks_the_open_front_only() {
         }
     }
 }
+
+/// `bench-rays --peer` reads the peer's rates from lines like the Embree script's.
+#[test]
+fn peer_ray_rates_are_read_from_their_lines() {
+    let out = "embreex 4.4  triangles 16140  pinned to CPU 0\n\
+        coherent primary (camera grid)     rays 1,048,576  hits 1,013,507 ( 96.7%)  wall 0.303 s  cpu 0.149 s    3.46 Mrays/s\n\
+        incoherent (random o, random d)    rays 1,048,576  hits   882,790 ( 84.2%)  wall 0.495 s  cpu 0.245 s    2.12 Mrays/s\n";
+    assert_eq!(crate::bench::peer_rate(out, "coherent"), Some(3.46));
+    assert_eq!(crate::bench::peer_rate(out, "incoherent"), Some(2.12));
+    assert_eq!(crate::bench::peer_rate("  coherent: 7.5 M rays/s\n", "coherent"), Some(7.5));
+    assert_eq!(crate::bench::peer_rate("coherent rays only\n", "coherent"), None);
+}
