@@ -15,7 +15,10 @@ fn scene(dir: &Path) -> PathBuf {
         .replace("height = 512", "height = 20")
         .replace(
             "obj = \"CornellBox.obj\"",
-            &format!("obj = {:?}", src.join("CornellBox.obj").display().to_string()),
+            &format!(
+                "obj = {:?}",
+                src.join("CornellBox.obj").display().to_string()
+            ),
         )
         + "\n[estimate.splat]\nphotons = 3000\n";
     let p = dir.join("s.toml");
@@ -62,7 +65,11 @@ fn sharded(dir: &Path, tag: &str, cmd: &str, n: u32) -> PathBuf {
     shards.rotate_left(n as usize / 2);
     shards.reverse();
     let merged = dir.join(format!("{tag}-{n}"));
-    run(&format!("merge {} --out {}", shards.join(" "), merged.display()));
+    run(&format!(
+        "merge {} --out {}",
+        shards.join(" "),
+        merged.display()
+    ));
     merged
 }
 
@@ -82,12 +89,12 @@ fn photon_files_from_1_3_and_7_shards_are_the_one_machine_files() {
         .filter(|(f, _)| f.ends_with(".photons"))
         .collect();
     assert_eq!(one.len(), 2, "a global and a caustic set");
-    assert!(one.iter().any(|(_, b)| b.len() > 32 * 65_536), "more than one chunk");
+    assert!(
+        one.iter().any(|(_, b)| b.len() > 32 * 65_536),
+        "more than one chunk"
+    );
     for n in [1, 3, 7] {
-        let cmd = format!(
-            "trace {} --photons 30000 --threads 2 --shard",
-            s.display()
-        );
+        let cmd = format!("trace {} --photons 30000 --threads 2 --shard", s.display());
         let merged = sharded(tmp.path(), "trace", &cmd, n);
         assert_eq!(files(&merged), one, "{n} shards");
     }

@@ -33,6 +33,10 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
   composite RUN... --out DIR
                       combine runs of one view: layers of one name averaged by their counts,
                       disjoint layers summed (independent runs: other --seed)
+  merge SHARD... --out DIR
+                      put the shards of one run (trace/render --shard I/N --out SHARD) back
+                      together: the one-machine photon files (DIR: a cache) or image, byte
+                      for byte; refuses missing, duplicated, overlapping or foreign shards
   compare A.exr B.exr [--mask x0,y0,x1,y1]
                       RMSE, relative MSE and mean absolute error of A against reference B
   info SCENE          load a scene and print what it holds
@@ -104,7 +108,7 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
         ["fuzz", rest @ ..] => Ok(Cmd::Fuzz(rest.iter().map(|s| s.to_string()).collect())),
         [
             cmd @ ("info" | "render" | "compare" | "composite" | "trace" | "estimate" | "worksheet"
-            | "evidence"),
+            | "evidence" | "merge"),
             rest @ ..,
         ] => Ok(Cmd::Photonflow(
             std::iter::once(*cmd)

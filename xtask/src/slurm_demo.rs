@@ -64,7 +64,14 @@ fn on_path(bin: &str) -> bool {
 
 /// Installs Debian's Slurm and munge packages if a daemon or client is missing.
 fn install() -> Result<(), String> {
-    let needed = ["munged", "slurmctld", "slurmd", "sbatch", "squeue", "scontrol"];
+    let needed = [
+        "munged",
+        "slurmctld",
+        "slurmd",
+        "sbatch",
+        "squeue",
+        "scontrol",
+    ];
     if needed.iter().all(|b| on_path(b)) {
         println!("slurm and munge are installed");
         return Ok(());
@@ -76,9 +83,18 @@ fn install() -> Result<(), String> {
             .env("DEBIAN_FRONTEND", "noninteractive"))
     };
     apt(&["update", "-q"])?;
-    apt(&["install", "-y", "-q", "--no-install-recommends", "slurm-wlm", "munge"])?;
+    apt(&[
+        "install",
+        "-y",
+        "-q",
+        "--no-install-recommends",
+        "slurm-wlm",
+        "munge",
+    ])?;
     match needed.iter().find(|b| !on_path(b)) {
-        Some(b) => Err(format!("{b} is still missing after installing slurm-wlm and munge")),
+        Some(b) => Err(format!(
+            "{b} is still missing after installing slurm-wlm and munge"
+        )),
         None => Ok(()),
     }
 }
@@ -96,7 +112,10 @@ fn wait(what: &str, limit: Duration, mut f: impl FnMut() -> bool) -> Result<(), 
         }
         std::thread::sleep(Duration::from_millis(500));
     }
-    Err(format!("timed out after {} s waiting for {what}", limit.as_secs()))
+    Err(format!(
+        "timed out after {} s waiting for {what}",
+        limit.as_secs()
+    ))
 }
 
 /// Files of a run directory compared byte for byte: the image and its layers.
@@ -221,8 +240,7 @@ fn demo(root: &Path, exe: &Path, tmp: &Path) -> Result<(), String> {
         &mut daemons,
     )?;
     wait("the node to be idle", Duration::from_secs(60), || {
-        sh(slurm("sinfo").args(["-h", "-N", "-o", "%T"]))
-            .is_ok_and(|s| s.trim() == "idle")
+        sh(slurm("sinfo").args(["-h", "-N", "-o", "%T"])).is_ok_and(|s| s.trim() == "idle")
     })?;
     println!("slurm is up: one node ({NODE}, {cpus} CPUs)");
 
@@ -232,14 +250,16 @@ fn demo(root: &Path, exe: &Path, tmp: &Path) -> Result<(), String> {
     let mut command: Vec<String> = vec!["render".into(), scene.clone()];
     command.extend(RENDER.iter().map(|s| s.to_string()));
     let t0 = Instant::now();
-    let ids = sh(slurm(&root.join("deploy/slurm/submit.sh").display().to_string())
-        .arg(SHARDS.to_string())
-        .arg(&shards)
-        .arg(&merged)
-        .arg("--")
-        .args(&command)
-        .env("PHOTONFLOW", exe)
-        .current_dir(root))?;
+    let ids = sh(
+        slurm(&root.join("deploy/slurm/submit.sh").display().to_string())
+            .arg(SHARDS.to_string())
+            .arg(&shards)
+            .arg(&merged)
+            .arg("--")
+            .args(&command)
+            .env("PHOTONFLOW", exe)
+            .current_dir(root),
+    )?;
     let (array, merge) = ids
         .trim()
         .split_once(' ')

@@ -89,7 +89,13 @@ pub fn cover(
         }
     }
     let mut order: Vec<usize> = (0..parts.len()).collect();
-    order.sort_by_key(|&i| (parts[i].range.start, parts[i].range.end, parts[i].shard.count));
+    order.sort_by_key(|&i| {
+        (
+            parts[i].range.start,
+            parts[i].range.end,
+            parts[i].shard.count,
+        )
+    });
     let mut end = 0;
     let mut prev: Option<&Part> = None;
     for &i in &order {
@@ -118,12 +124,7 @@ pub fn cover(
     Ok(order)
 }
 
-fn missing(
-    near: &Part,
-    from: u64,
-    to: u64,
-    expected: &dyn Fn(ShardId) -> Range<u64>,
-) -> String {
+fn missing(near: &Part, from: u64, to: u64, expected: &dyn Fn(ShardId) -> Range<u64>) -> String {
     let n = near.shard.count;
     let lost: Vec<String> = (0..n)
         .map(|index| ShardId { index, count: n })

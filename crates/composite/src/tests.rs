@@ -735,7 +735,11 @@ fn a_shard_set_is_refused_unless_it_covers_every_index_once() {
         }
     };
     let expect = |s: ShardId| s.range(100);
-    let order = cover(&[part("c", 2, 3), part("a", 0, 3), part("b", 1, 3)], 100, &expect);
+    let order = cover(
+        &[part("c", 2, 3), part("a", 0, 3), part("b", 1, 3)],
+        100,
+        &expect,
+    );
     assert_eq!(order, Ok(vec![1, 2, 0]));
     let refusal = |parts: &[Part]| cover(parts, 100, &expect).unwrap_err();
     let e = refusal(&[part("a", 0, 3), part("c", 2, 3)]);
@@ -749,5 +753,8 @@ fn a_shard_set_is_refused_unless_it_covers_every_index_once() {
     let mut forged = part("f", 1, 2);
     forged.range = 40..100;
     let e = refusal(&[part("a", 0, 2), forged]);
-    assert!(e.starts_with("f: ") && e.contains("should cover 50..100"), "{e}");
+    assert!(
+        e.starts_with("f: ") && e.contains("should cover 50..100"),
+        "{e}"
+    );
 }

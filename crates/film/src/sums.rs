@@ -100,7 +100,8 @@ pub fn read_sums(path: &Path) -> Result<Sums, FilmError> {
     if b.get(..8) != Some(&MAGIC[..]) {
         return Err(bad("not a file of f64 sums (bad magic)".into()));
     }
-    let (Some(version), Some(w), Some(h), Some(p)) = (u32_at(8), u32_at(12), u32_at(16), u32_at(20))
+    let (Some(version), Some(w), Some(h), Some(p)) =
+        (u32_at(8), u32_at(12), u32_at(16), u32_at(20))
     else {
         return Err(bad(format!("truncated: {} bytes", b.len())));
     };

@@ -643,7 +643,12 @@ fn sums_files_round_trip_exactly_and_refuse_damage() {
     write_sums(&p, &s).unwrap();
     let back = read_sums(&p).unwrap();
     let bits = |s: &Sums| -> Vec<u64> {
-        s.planes.iter().flatten().flatten().map(|v| v.to_bits()).collect()
+        s.planes
+            .iter()
+            .flatten()
+            .flatten()
+            .map(|v| v.to_bits())
+            .collect()
     };
     assert_eq!((back.width, back.height), (3, 2));
     assert_eq!(bits(&back), bits(&s));

@@ -607,8 +607,8 @@ fn run(cmd: Cmd) -> Result<(), String> {
                 ..Overrides::default()
             };
             if let Some(shard) = shard {
-                let out = out
-                    .unwrap_or_else(|| pipeline::shard::default_out(&scene, "trace", shard));
+                let out =
+                    out.unwrap_or_else(|| pipeline::shard::default_out(&scene, "trace", shard));
                 let m = pipeline::shard::trace(&s, &overrides, shard, &out, threads)?;
                 println!(
                     "traced shard {shard}: photon paths {}..{} of {} in {:.2} s into {}",

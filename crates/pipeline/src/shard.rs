@@ -116,8 +116,7 @@ fn start(out: &Path) -> Result<PathBuf, String> {
         std::process::id()
     ));
     let _ = std::fs::remove_dir_all(&tmp);
-    std::fs::create_dir_all(&tmp)
-        .map_err(|e| format!("{}: cannot create: {e}", tmp.display()))?;
+    std::fs::create_dir_all(&tmp).map_err(|e| format!("{}: cannot create: {e}", tmp.display()))?;
     Ok(tmp)
 }
 
@@ -131,7 +130,8 @@ fn publish(tmp: &Path, out: &Path, m: &Manifest) -> Result<(), String> {
         std::fs::rename(out, &old)
             .map_err(|e| format!("{}: cannot replace: {e}", out.display()))?;
     }
-    std::fs::rename(tmp, out).map_err(|e| format!("{}: cannot rename into place: {e}", out.display()))?;
+    std::fs::rename(tmp, out)
+        .map_err(|e| format!("{}: cannot rename into place: {e}", out.display()))?;
     let _ = std::fs::remove_dir_all(&old);
     Ok(())
 }
@@ -229,10 +229,7 @@ pub fn render(run: &Run, shard: ShardId, out: &Path) -> Result<Manifest, String>
     let layers = b.acc.layer_names();
     let tmp = start(out)?;
     let t0 = std::time::Instant::now();
-    let (w, h) = (
-        scene.camera.width as usize,
-        scene.camera.height as usize,
-    );
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let mut planes = Vec::new();
     let mut count = 0;
     let work: u64 = b.blocks[mine.clone()].iter().map(|r| r.end - r.start).sum();
@@ -302,8 +299,8 @@ fn read_input(p: &Path) -> Result<Input, String> {
             path.display()
         )
     })?;
-    let m: Manifest =
-        serde_json::from_str(&text).map_err(|e| format!("{}: not a shard manifest: {e}", path.display()))?;
+    let m: Manifest = serde_json::from_str(&text)
+        .map_err(|e| format!("{}: not a shard manifest: {e}", path.display()))?;
     if m.photonflow_shard != VERSION {
         return Err(format!(
             "{}: shard format {}, this photonflow reads {VERSION}",
@@ -364,7 +361,11 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<String, String> {
             || b.m.layers != a.m.layers
             || b.m.sets != a.m.sets
         {
-            return Err(differs("parameter hash", &b.m.params_hash, &a.m.params_hash));
+            return Err(differs(
+                "parameter hash",
+                &b.m.params_hash,
+                &a.m.params_hash,
+            ));
         }
     }
     if out.exists() && all.iter().any(|i| same_dir(&i.dir, out)) {
@@ -388,8 +389,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<String, String> {
             merge_photons(&all, &order, out)
         }
         "image" => {
-            let blocks: Vec<std::ops::Range<u64>> =
-                a.m.blocks.iter().map(|b| b[0]..b[1]).collect();
+            let blocks: Vec<std::ops::Range<u64>> = a.m.blocks.iter().map(|b| b[0]..b[1]).collect();
             let end = blocks.last().map_or(0, |r| r.end);
             let expect = |s: ShardId| {
                 let r = s.blocks(&blocks, end);
@@ -445,7 +445,10 @@ fn merge_photons(all: &[Input], order: &[usize], out: &Path) -> Result<String, S
             let problem = if h.kind != k {
                 Some(format!("holds the {} set", h.kind.name()))
             } else if h.seed != inp.m.seed {
-                Some(format!("seed {}, its shard.json says {}", h.seed, inp.m.seed))
+                Some(format!(
+                    "seed {}, its shard.json says {}",
+                    h.seed, inp.m.seed
+                ))
             } else if h.scene_hash != scene_hash || h.params_hash != params_hash {
                 Some("was traced for another scene or parameters than its shard.json says".into())
             } else if h.emitted != inp.m.count || inp.m.count != inp.m.range[1] - inp.m.range[0] {
@@ -485,7 +488,13 @@ fn merge_photons(all: &[Input], order: &[usize], out: &Path) -> Result<String, S
     let mut stored = 0;
     for (j, &k) in kinds.iter().enumerate() {
         let path = key.file(out, k);
-        let header = Header::new(k, a.m.seed, scene_hash, params_hash, key.params_json.clone());
+        let header = Header::new(
+            k,
+            a.m.seed,
+            scene_hash,
+            params_hash,
+            key.params_json.clone(),
+        );
         let mut w = StoreWriter::create(&path, header).map_err(|e| e.to_string())?;
         for row in &stores {
             for chunk in row[j].chunks() {

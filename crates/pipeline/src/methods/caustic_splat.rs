@@ -190,7 +190,9 @@ impl super::Accumulate for Progressive<'_> {
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Vec<Vec<glam::DVec3>>, String> {
         if block.end != block.start + 1 {
-            return Err(format!("splatting's blocks are single passes, not {block:?}"));
+            return Err(format!(
+                "splatting's blocks are single passes, not {block:?}"
+            ));
         }
         Progressive::block(self, block.start, progress)
     }
