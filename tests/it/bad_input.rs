@@ -825,6 +825,202 @@ fn cases() -> Vec<Case> {
             words: &[],
             check: present("out/plan.txt", "no surface is diffuse"),
         },
+        // Shards and merge (issue 14): a bad set is refused naming the file, nothing written.
+        Case {
+            name: "merge: a shard missing",
+            files: good(),
+            setup: vec![
+                "trace {d}/s.toml --photons 2000 --shard 0/3 --out {d}/a0",
+                "trace {d}/s.toml --photons 2000 --shard 2/3 --out {d}/a2",
+            ],
+            prepare: None,
+            args: "merge {d}/a2 {d}/a0 --out {d}/m",
+            code: 1,
+            words: &["a2/shard.json", "missing", "1/3"],
+            check: absent("m"),
+        },
+        Case {
+            name: "merge: the last shard missing",
+            files: good(),
+            setup: vec!["render {d}/s.toml --method path --spp 8 --shard 0/2 --out {d}/a0"],
+            prepare: None,
+            args: "merge {d}/a0 --out {d}/m",
+            code: 1,
+            words: &["a0/shard.json", "missing", "1/2"],
+            check: absent("m"),
+        },
+        Case {
+            name: "merge: a shard given twice",
+            files: good(),
+            setup: vec![
+                "trace {d}/s.toml --photons 2000 --shard 0/2 --out {d}/a0",
+                "trace {d}/s.toml --photons 2000 --shard 0/2 --out {d}/b0",
+                "trace {d}/s.toml --photons 2000 --shard 1/2 --out {d}/a1",
+            ],
+            prepare: None,
+            args: "merge {d}/a0 {d}/a1 {d}/b0 --out {d}/m",
+            code: 1,
+            words: &["b0/shard.json", "duplicates", "a0/shard.json"],
+            check: absent("m"),
+        },
+        Case {
+            name: "merge: overlapping shards of two sets",
+            files: good(),
+            setup: vec![
+                "trace {d}/s.toml --photons 2000 --shard 0/2 --out {d}/a0",
+                "trace {d}/s.toml --photons 2000 --shard 1/3 --out {d}/b1",
+                "trace {d}/s.toml --photons 2000 --shard 2/3 --out {d}/b2",
+            ],
+            prepare: None,
+            args: "merge {d}/a0 {d}/b1 {d}/b2 --out {d}/m",
+            code: 1,
+            words: &["b1/shard.json", "overlaps", "a0/shard.json"],
+            check: absent("m"),
+        },
+        Case {
+            name: "merge: shards of another seed",
+            files: good(),
+            setup: vec![
+                "trace {d}/s.toml --photons 2000 --shard 0/2 --out {d}/a0",
+                "trace {d}/s.toml --photons 2000 --seed 7 --shard 1/2 --out {d}/a1",
+            ],
+            prepare: None,
+            args: "merge {d}/a0 {d}/a1 --out {d}/m",
+            code: 1,
+            words: &["a1/shard.json", "seed 7"],
+            check: absent("m"),
+        },
+        Case {
+            name: "merge: shards of another scene",
+            files: with(
+                with(good(), "t.toml", text(scene("").replace("a.obj", "b.obj"))),
+                "b.obj",
+                text(OBJ.replace("v 1 0 1", "v 1 0 1.5")),
+            ),
+            setup: vec![
+                "trace {d}/s.toml --photons 2000 --shard 0/2 --out {d}/a0",
+                "trace {d}/t.toml --photons 2000 --shard 1/2 --out {d}/a1",
+            ],
+            prepare: None,
+            args: "merge {d}/a0 {d}/a1 --out {d}/m",
+            code: 1,
+            words: &["a1/shard.json", "scene hash"],
+            check: absent("m"),
+        },
+        Case {
+            name: "merge: image shards of another parameter set",
+            files: good(),
+            setup: vec![
+                "render {d}/s.toml --method path --spp 8 --shard 0/2 --out {d}/a0",
+                "render {d}/s.toml --method path --spp 8 --no-caustics --shard 1/2 --out {d}/a1",
+            ],
+            prepare: None,
+            args: "merge {d}/a0 {d}/a1 --out {d}/m",
+            code: 1,
+            words: &["a1/shard.json", "parameter hash"],
+            check: absent("m"),
+        },
+        Case {
+            name: "merge: photon shards with an image shard",
+            files: good(),
+            setup: vec![
+                "trace {d}/s.toml --photons 2000 --shard 0/2 --out {d}/a0",
+                "render {d}/s.toml --method path --spp 8 --shard 1/2 --out {d}/a1",
+            ],
+            prepare: None,
+            args: "merge {d}/a0 {d}/a1 --out {d}/m",
+            code: 1,
+            words: &["a1/shard.json", "holds image"],
+            check: absent("m"),
+        },
+        Case {
+            name: "merge: an unfinished shard (no shard.json)",
+            files: with(good(), "a1/global.photons", text("partial")),
+            setup: vec!["trace {d}/s.toml --photons 2000 --shard 0/2 --out {d}/a0"],
+            prepare: None,
+            args: "merge {d}/a0 {d}/a1 --out {d}/m",
+            code: 1,
+            words: &["a1/shard.json", "not a complete shard"],
+            check: absent("m"),
+        },
+        Case {
+            name: "merge: a damaged photon shard",
+            files: good(),
+            setup: vec![
+                "trace {d}/s.toml --photons 2000 --shard 0/2 --out {d}/a0",
+                "trace {d}/s.toml --photons 2000 --shard 1/2 --out {d}/a1",
+            ],
+            prepare: Some(|d| {
+                let p = d.join("a1/global.photons");
+                let mut b = std::fs::read(&p).unwrap();
+                let n = b.len();
+                b[n - 5] ^= 0x10;
+                std::fs::write(&p, b).unwrap();
+            }),
+            args: "merge {d}/a0 {d}/a1 --out {d}/m",
+            code: 1,
+            words: &["a1/global.photons", "checksum"],
+            check: absent("m"),
+        },
+        Case {
+            name: "merge: a damaged image shard",
+            files: good(),
+            setup: vec!["render {d}/s.toml --method path --spp 8 --shard 0/1 --out {d}/a0"],
+            prepare: Some(|d| {
+                let p = d.join("a0/sums.f64");
+                let mut b = std::fs::read(&p).unwrap();
+                b[100] ^= 0x01;
+                std::fs::write(&p, b).unwrap();
+            }),
+            args: "merge {d}/a0 --out {d}/m",
+            code: 1,
+            words: &["a0/sums.f64", "checksum"],
+            check: absent("m"),
+        },
+        Case {
+            name: "merge: a shard file whose range is not its shard's",
+            files: good(),
+            setup: vec!["trace {d}/s.toml --photons 2000 --shard 0/1 --out {d}/a0"],
+            prepare: Some(|d| {
+                let p = d.join("a0/shard.json");
+                let t = std::fs::read_to_string(&p).unwrap();
+                std::fs::write(&p, t.replace("\"shard\": \"0/1\"", "\"shard\": \"0/2\"")).unwrap();
+            }),
+            args: "merge {d}/a0 --out {d}/m",
+            code: 1,
+            words: &["a0/shard.json", "should cover"],
+            check: absent("m"),
+        },
+        Case {
+            name: "--shard I/N with I = N",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "trace {d}/s.toml --photons 2000 --shard 3/3",
+            code: 2,
+            words: &["--shard", "0 <= I < N"],
+            check: None,
+        },
+        Case {
+            name: "render --shard of sppm",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method sppm --photons 2000 --shard 0/2 --out {d}/a0",
+            code: 1,
+            words: &["sppm", "depend on each other"],
+            check: absent("a0"),
+        },
+        Case {
+            name: "render --shard with a time budget",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method path --time 1 --shard 0/2 --out {d}/a0",
+            code: 1,
+            words: &["--shard", "--time"],
+            check: absent("a0"),
+        },
         // Temporary files.
         Case {
             name: "a stale temp file of a dead process",

@@ -25,6 +25,8 @@
 //!   in flight, a hostile scene (finite pixels, flux kept), the same bits on 1 and 2 threads.
 //! - `fuzz`: the fuzz loops of `tests::fuzz` over every loader (mutated OBJ, MTL, scene,
 //!   photon and EXR files: no panic, hang or header-sized allocation).
+//! - `shards`: `trace --shard` and `render --shard` (path, caustic-splat) with 1, 3 and 7
+//!   shards merged give the one-machine run's photon files and images byte for byte.
 //! - `sppm`: progressive photon mapping converging to closed forms (square light, furnace) at
 //!   the rate its radius schedule predicts; snapshots, time budget, thread-count invariance.
 
@@ -39,5 +41,6 @@ mod fuzz;
 mod hard_cases;
 mod photon_maps;
 mod photons;
+mod shards;
 mod splat;
 mod sppm;

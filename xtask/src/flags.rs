@@ -33,6 +33,10 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
   composite RUN... --out DIR
                       combine runs of one view: layers of one name averaged by their counts,
                       disjoint layers summed (independent runs: other --seed)
+  merge SHARD... --out DIR
+                      put the shards of one run (trace/render --shard I/N --out SHARD) back
+                      together: the one-machine photon files (DIR: a cache) or image, byte
+                      for byte; refuses missing, duplicated, overlapping or foreign shards
   compare A.exr B.exr [--mask x0,y0,x1,y1]
                       RMSE, relative MSE and mean absolute error of A against reference B
   info SCENE          load a scene and print what it holds
@@ -58,6 +62,10 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
   bench knn [--photons N] [--queries N]
                       k-NN queries/s for k = 50, 250, 1000 per index (kd-tree, kiddo, brute),
                       and pixel-order irradiance queries with radius hints
+  slurm-demo          as root: install Slurm (Debian's slurm-wlm, munge) if missing, start a
+                      one-node cluster in a temporary directory, render an array of 4 shards
+                      and their merge (deploy/slurm/), check the result against a one-machine
+                      run byte for byte, stop the daemons
   gen-scenes          rewrite the generated OBJ/MTL files under scenes/
   fuzz [--seconds N] [--target obj|mtl|scene|photons|exr] [--seed S]
                       mutate valid files and feed them to each loader for N seconds per target
@@ -67,6 +75,8 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
 pub enum Cmd {
     Help,
     GenScenes,
+    /// Slurm on this machine: shards, merge, checked against a one-machine run.
+    SlurmDemo,
     /// The fuzz loops (`tests/bin/fuzz.rs`), with these arguments.
     Fuzz(Vec<String>),
     /// Arguments passed straight to the photonflow binary (release build).
@@ -94,10 +104,11 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
     match a.as_slice() {
         [] | ["help" | "-h" | "--help", ..] => Ok(Cmd::Help),
         ["gen-scenes"] => Ok(Cmd::GenScenes),
+        ["slurm-demo"] => Ok(Cmd::SlurmDemo),
         ["fuzz", rest @ ..] => Ok(Cmd::Fuzz(rest.iter().map(|s| s.to_string()).collect())),
         [
             cmd @ ("info" | "render" | "compare" | "composite" | "trace" | "estimate" | "worksheet"
-            | "evidence"),
+            | "evidence" | "merge"),
             rest @ ..,
         ] => Ok(Cmd::Photonflow(
             std::iter::once(*cmd)

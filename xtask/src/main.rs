@@ -7,6 +7,7 @@
 mod benchmarks;
 mod flags;
 mod gen_scenes;
+mod slurm_demo;
 #[cfg(test)]
 mod tests;
 mod tidy;
@@ -33,6 +34,7 @@ fn run(args: &[String]) -> Result<(), String> {
             Ok(())
         }
         flags::Cmd::GenScenes => gen_scenes::run(&project_root()),
+        flags::Cmd::SlurmDemo => slurm_demo::run(&project_root(), &build("release")?),
         flags::Cmd::Fuzz(args) => fuzz(&args),
         flags::Cmd::Photonflow(args) => photonflow(&build("release")?, &args),
         // `release-lto` is the profile published numbers use.

@@ -28,6 +28,7 @@
 
 mod combine;
 mod meta;
+pub mod shards;
 
 pub use combine::{Composite, CompositeLayer, Input, composite};
 pub use meta::{Class, CountKind, LayerMeta, Meta};

@@ -690,3 +690,71 @@ fn runs_sharing_a_seed_are_not_averaged() {
     e.layers[0].0 = "emitted".into();
     composite(vec![seeded("a", 7, [1.0; 3]), e]).unwrap();
 }
+
+#[test]
+fn shard_ranges_partition_the_indices_and_blocks_stay_whole() {
+    use crate::shards::ShardId;
+    for total in [0u64, 1, 7, 30_000, u64::MAX / 3] {
+        for n in 1..=9 {
+            let mut end = 0;
+            for i in 0..n {
+                let r = ShardId { index: i, count: n }.range(total);
+                assert_eq!(r.start, end, "{i}/{n} of {total}");
+                assert!(r.end - r.start <= total / n as u64 + 1);
+                end = r.end;
+            }
+            assert_eq!(end, total);
+        }
+    }
+    // The path tracer's passes of 16 samples: 1, 1, 2, 2, ... Seven shards own disjoint,
+    // consecutive runs of whole blocks covering all of them.
+    let starts = [0u64, 1, 2, 4, 6, 8, 10, 12, 14, 16];
+    let blocks: Vec<_> = starts.windows(2).map(|w| w[0]..w[1]).collect();
+    let mut next = 0;
+    for i in 0..7 {
+        let b = ShardId { index: i, count: 7 }.blocks(&blocks, 16);
+        assert_eq!(b.start, next);
+        next = b.end;
+    }
+    assert_eq!(next, blocks.len());
+    assert_eq!(ShardId::parse("2/7"), Ok(ShardId { index: 2, count: 7 }));
+    for bad in ["7/7", "1", "-1/3", "a/b", "0/0"] {
+        assert!(ShardId::parse(bad).is_err(), "{bad}");
+    }
+}
+
+#[test]
+fn a_shard_set_is_refused_unless_it_covers_every_index_once() {
+    use crate::shards::{Part, ShardId, cover};
+    let part = |label: &str, index, count| {
+        let shard = ShardId { index, count };
+        Part {
+            label: label.into(),
+            shard,
+            range: shard.range(100),
+        }
+    };
+    let expect = |s: ShardId| s.range(100);
+    let order = cover(
+        &[part("c", 2, 3), part("a", 0, 3), part("b", 1, 3)],
+        100,
+        &expect,
+    );
+    assert_eq!(order, Ok(vec![1, 2, 0]));
+    let refusal = |parts: &[Part]| cover(parts, 100, &expect).unwrap_err();
+    let e = refusal(&[part("a", 0, 3), part("c", 2, 3)]);
+    assert!(e.starts_with("c: ") && e.contains("missing (1/3)"), "{e}");
+    let e = refusal(&[part("a", 0, 3), part("b", 1, 3)]);
+    assert!(e.starts_with("b: ") && e.contains("missing (2/3)"), "{e}");
+    let e = refusal(&[part("a", 0, 2), part("b", 1, 2), part("b2", 1, 2)]);
+    assert!(e.starts_with("b2: ") && e.contains("duplicates b"), "{e}");
+    let e = refusal(&[part("a", 0, 2), part("x", 1, 3), part("y", 2, 3)]);
+    assert!(e.starts_with("x: ") && e.contains("overlaps a"), "{e}");
+    let mut forged = part("f", 1, 2);
+    forged.range = 40..100;
+    let e = refusal(&[part("a", 0, 2), forged]);
+    assert!(
+        e.starts_with("f: ") && e.contains("should cover 50..100"),
+        "{e}"
+    );
+}

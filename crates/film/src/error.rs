@@ -39,6 +39,8 @@ pub enum FilmError {
     EmptyRegion,
     /// Bias and variance apart need at least two independent runs.
     TooFewRuns { runs: usize },
+    /// A file of f64 sums ([`crate::read_sums`]) that is not one, or is damaged.
+    Sums { path: PathBuf, problem: String },
 }
 
 impl fmt::Display for FilmError {
@@ -71,6 +73,7 @@ impl fmt::Display for FilmError {
                 f,
                 "bias and variance need at least two independent runs, got {runs}"
             ),
+            Self::Sums { path, problem } => write!(f, "{}: {problem}", path.display()),
         }
     }
 }

@@ -22,6 +22,7 @@ mod flip;
 mod img;
 mod io;
 mod metrics;
+mod sums;
 
 pub use bias::{BiasVariance, RegionSums};
 pub use error::FilmError;
@@ -30,6 +31,7 @@ pub use flip::{FlipMap, flip};
 pub use img::{Image, composite};
 pub use io::{ToneMap, read_exr, write_atomic, write_exr, write_png};
 pub use metrics::{Mask, Metrics, RELMSE_EPSILON, metrics};
+pub use sums::{Sums, read_sums, write_sums};
 
 #[cfg(test)]
 mod tests;

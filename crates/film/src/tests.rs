@@ -627,3 +627,40 @@ fn flip_reports_size_problems_as_errors() {
     assert_eq!(map.mean(Some(&Mask::rect(4, 4, 0, 0, 0, 0))).unwrap(), None);
     assert!(flip(&Image::new(0, 0), &Image::new(0, 0), 1.0).is_err());
 }
+
+#[test]
+fn sums_files_round_trip_exactly_and_refuse_damage() {
+    let dir = scratch("sums");
+    let p = dir.join("a.f64");
+    let s = Sums {
+        width: 3,
+        height: 2,
+        planes: vec![
+            (0..6).map(|i| [i as f64 * 0.1, -0.0, 1e-300]).collect(),
+            (0..6).map(|i| [f64::MAX, i as f64 / 3.0, 7.0]).collect(),
+        ],
+    };
+    write_sums(&p, &s).unwrap();
+    let back = read_sums(&p).unwrap();
+    let bits = |s: &Sums| -> Vec<u64> {
+        s.planes
+            .iter()
+            .flatten()
+            .flatten()
+            .map(|v| v.to_bits())
+            .collect()
+    };
+    assert_eq!((back.width, back.height), (3, 2));
+    assert_eq!(bits(&back), bits(&s));
+    let good = std::fs::read(&p).unwrap();
+    for (i, what) in [(30, "checksum"), (0, "magic"), (8, "version")] {
+        let mut b = good.clone();
+        b[i] ^= 1;
+        std::fs::write(&p, &b).unwrap();
+        let e = read_sums(&p).unwrap_err().to_string();
+        assert!(e.contains("a.f64") && e.contains(what), "{e}");
+    }
+    std::fs::write(&p, &good[..good.len() - 1]).unwrap();
+    let e = read_sums(&p).unwrap_err().to_string();
+    assert!(e.contains("bytes"), "{e}");
+}

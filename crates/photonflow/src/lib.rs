@@ -115,6 +115,11 @@ enum Cmd {
         /// first diffuse vertex from the eye), so a splatted caustic layer can be added.
         #[arg(long)]
         no_caustics: bool,
+        /// Render only shard I of N (counted from 0) of the run: `path` by its passes of
+        /// samples, `caustic-splat` by its passes, into a shard directory (--out, default
+        /// out/shards/...) for `merge`.
+        #[arg(long, value_parser = pipeline::shard::ShardId::parse)]
+        shard: Option<pipeline::shard::ShardId>,
     },
     /// Estimate an image from cached photon sets (never traces).
     Estimate {
@@ -198,6 +203,26 @@ enum Cmd {
         /// Trace even if the cache holds the sets.
         #[arg(long)]
         force: bool,
+        /// Trace only shard I of N (counted from 0): photon paths [I P / N, (I + 1) P / N),
+        /// into a shard directory (--out) for `merge`, not into the cache.
+        #[arg(long, value_parser = pipeline::shard::ShardId::parse)]
+        shard: Option<pipeline::shard::ShardId>,
+        /// The shard directory (default: out/shards/<scene dir>-<stem>-trace-I-of-N).
+        #[arg(long, requires = "shard")]
+        out: Option<PathBuf>,
+    },
+    /// Put the shards of one run (`trace --shard`, `render --shard`) back together, in shard
+    /// order, into the result the one-machine run writes, byte for byte: photon sets into a
+    /// cache directory, images into a run directory. Refuses a missing, duplicated or
+    /// overlapping shard, or shards of another scene, seed or parameter set.
+    Merge {
+        /// Shard directories (any order).
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+        /// Photon shards: the cache directory to write the photon files into; image shards:
+        /// the run directory to write.
+        #[arg(long)]
+        out: PathBuf,
     },
     /// Combine runs of one view (their output directories or `image.exr` paths): layers of
     /// one name averaged by their counts, disjoint layers summed, in f64, in a fixed order.
@@ -448,12 +473,16 @@ fn run(cmd: Cmd) -> Result<(), String> {
             photon,
             image,
             no_caustics,
+            shard,
         } => {
             let s = load(&scene, photon.seed)?;
             let overrides = Overrides {
                 caustics: no_caustics.then_some(false),
                 ..photon.overrides(method, image.spp)
             };
+            if let Some(shard) = shard {
+                return render_shard(&s, &overrides, &photon, &image, shard);
+            }
             render(
                 &s,
                 RenderRequest {
@@ -591,15 +620,71 @@ fn run(cmd: Cmd) -> Result<(), String> {
             cache,
             threads,
             force,
+            shard,
+            out,
         } => {
             let s = load(&scene, seed)?;
             let overrides = Overrides {
                 photons,
                 ..Overrides::default()
             };
+            if let Some(shard) = shard {
+                let out =
+                    out.unwrap_or_else(|| pipeline::shard::default_out(&scene, "trace", shard));
+                let m = pipeline::shard::trace(&s, &overrides, shard, &out, threads)?;
+                println!(
+                    "traced shard {shard}: photon paths {}..{} of {} in {:.2} s into {}",
+                    m.range[0],
+                    m.range[1],
+                    m.total,
+                    m.seconds,
+                    out.display()
+                );
+                return Ok(());
+            }
             pipeline::trace(&s, &overrides, &cache, threads, force).map(|_| ())
         }
+        Cmd::Merge { inputs, out } => {
+            println!("{}", pipeline::shard::merge(&inputs, &out)?);
+            Ok(())
+        }
     }
+}
+
+/// `render --shard`: the shard's blocks of the run into a shard directory.
+fn render_shard(
+    scene: &Scene,
+    overrides: &Overrides,
+    photon: &PhotonArgs,
+    image: &ImageArgs,
+    shard: pipeline::shard::ShardId,
+) -> Result<(), String> {
+    let settings = pipeline::Settings::new(scene, overrides)?;
+    let label = photon
+        .label
+        .clone()
+        .unwrap_or_else(|| settings.method.name());
+    let out = image
+        .out
+        .clone()
+        .unwrap_or_else(|| pipeline::shard::default_out(&scene.path, &label, shard));
+    let run = pipeline::Run {
+        scene,
+        settings: &settings,
+        cache: &photon.cache,
+        photons: Photons::TraceOrReuse,
+        threads: image.threads,
+    };
+    let m = pipeline::shard::render(&run, shard, &out)?;
+    println!(
+        "rendered shard {shard} of {}: {} {} in {:.2} s into {}",
+        settings.method,
+        m.count,
+        m.unit,
+        m.seconds,
+        out.display()
+    );
+    Ok(())
 }
 
 fn info(path: &Path) -> Result<(), String> {

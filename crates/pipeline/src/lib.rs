@@ -14,6 +14,7 @@
 //! - [`methods`]: one file per method, one `match` on `scene::Method`.
 //! - [`output`]: a run's directory (EXR, PNG, layers, JSON, resolved scene).
 //! - [`worksheet`]: worksheet 7's report.
+//! - [`shard`]: a run split into shards by index ranges, and their exact merge.
 //!
 //! File IO happens only at paths the caller passes in.
 
@@ -31,6 +32,7 @@ pub mod plots;
 pub mod progress;
 pub mod report;
 pub mod settings;
+pub mod shard;
 pub mod splat;
 pub mod worksheet;
 

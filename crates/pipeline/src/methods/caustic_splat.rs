@@ -50,10 +50,31 @@ impl<'a> Progressive<'a> {
 
     /// One more pass.
     pub(super) fn step(&mut self, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
+        let block = self.block(self.passes as u64, progress)?;
+        self.add(&block);
+        Ok(())
+    }
+
+    /// The layers' names, in the order [`Progressive::block`] returns their sums.
+    pub(super) fn layer_names(&self) -> Vec<String> {
+        let n = if self.images[1].is_empty() { 1 } else { 2 };
+        ["caustic", "caustic_indirect"][..n]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    }
+
+    /// The f64 sums per pixel of pass `pass` alone, per layer: the unit a shard renders and a
+    /// merge adds. Passes are independent (new eye vertices and photons from their own
+    /// streams), so any range of them can run anywhere.
+    pub(super) fn block(
+        &mut self,
+        pass: u64,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<Vec<Vec<glam::DVec3>>, String> {
         let (run, s) = (self.run, self.run.settings);
         let sp = &s.estimate.splat;
         let t0 = std::time::Instant::now();
-        let pass = self.passes as u64;
         let eyes = splat::eye_index(run.scene, sp, s.estimate.spp, pass, run.threads);
         self.t_vertices += t0.elapsed().as_secs_f64();
         self.vertices += eyes.len();
@@ -63,10 +84,28 @@ impl<'a> Progressive<'a> {
             settings: sp,
             eyes: &eyes,
         };
-        let stats = splatter.pass(pass, &mut self.images, run.threads(), progress)?;
+        // The pass's own sums, added to the run's afterwards: a shard's passes then add up
+        // exactly as the one-machine run's do.
+        let mut images = [
+            vec![glam::DVec3::ZERO; self.images[0].len()],
+            vec![glam::DVec3::ZERO; self.images[1].len()],
+        ];
+        let stats = splatter.pass(pass, &mut images, run.threads(), progress)?;
         self.max_in_flight = self.max_in_flight.max(stats.max_in_flight);
-        self.passes += 1;
         self.t_splat += t0.elapsed().as_secs_f64();
+        let n = self.layer_names().len();
+        Ok(images.into_iter().take(n).collect())
+    }
+
+    /// Adds one pass's sums ([`Progressive::block`]) to the run's.
+    pub(super) fn add(&mut self, block: &[Vec<glam::DVec3>]) {
+        for (sums, b) in self.images.iter_mut().zip(block) {
+            for (s, v) in sums.iter_mut().zip(b) {
+                *s += *v;
+            }
+        }
+        self.passes += 1;
+        let sp = &self.run.settings.estimate.splat;
         if sp.passes > 1 {
             eprintln!(
                 "splat pass {}/{}: {:.2} s, {:.3} M photons/s",
@@ -76,7 +115,6 @@ impl<'a> Progressive<'a> {
                 (self.passes as u64 * self.params.photons) as f64 / self.t_splat / 1e6
             );
         }
-        Ok(())
     }
 
     /// The layers so far, each the mean over the passes made.
@@ -128,6 +166,52 @@ impl<'a> Progressive<'a> {
             info.insert(k.to_string(), v);
         }
         info
+    }
+}
+
+/// Splatting's run as blocks: its passes, one block each.
+pub(super) fn blocks<'a>(run: &'a Run<'a>) -> super::Blocks<'a> {
+    let passes = run.settings.estimate.splat.passes as u64;
+    super::Blocks {
+        acc: Box::new(Progressive::new(run)),
+        blocks: (0..passes).map(|j| j..j + 1).collect(),
+        unit: "passes",
+    }
+}
+
+impl super::Accumulate for Progressive<'_> {
+    fn layer_names(&self) -> Vec<String> {
+        Progressive::layer_names(self)
+    }
+
+    fn block(
+        &mut self,
+        block: std::ops::Range<u64>,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<Vec<Vec<glam::DVec3>>, String> {
+        if block.end != block.start + 1 {
+            return Err(format!(
+                "splatting's blocks are single passes, not {block:?}"
+            ));
+        }
+        Progressive::block(self, block.start, progress)
+    }
+
+    fn add(&mut self, sums: &[Vec<glam::DVec3>], _passes: u64) {
+        Progressive::add(self, sums);
+    }
+
+    fn finish(&self, seconds: f64) -> Rendered {
+        let mut info = self.facts();
+        info.insert("time_render_s".into(), seconds.into());
+        Rendered {
+            layers: self.layers(),
+            plan: None,
+            info,
+            passes: Some(self.passes),
+            samples: None,
+            snapshots: Vec::new(),
+        }
     }
 }
 

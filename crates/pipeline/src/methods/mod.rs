@@ -113,6 +113,9 @@ pub use composite::CountKind;
 /// What the rest of the program needs to know of a method.
 pub struct MethodSpec {
     pub render: RenderFn,
+    /// Its run as independent blocks of work, which shards split (`None`: it cannot be
+    /// split exactly, and the string says why).
+    pub blocks: Result<BlocksFn, &'static str>,
     /// It reads photon maps: `estimate` may run it from cached photon sets.
     pub photon_maps: bool,
     /// Its samples per pixel (and `--spp`) are `[estimate] spp` (else `[render] spp`, the
@@ -123,6 +126,36 @@ pub struct MethodSpec {
 }
 
 type RenderFn = fn(&Run, &(dyn Fn(u64) + Sync)) -> Result<Rendered, String>;
+
+/// A method's run as blocks: an accumulator, the blocks of the whole run in the order they
+/// are added, and what their indices count.
+pub type BlocksFn = for<'a> fn(&'a Run<'a>) -> Blocks<'a>;
+
+/// What [`BlocksFn`] returns.
+pub struct Blocks<'a> {
+    pub acc: Box<dyn Accumulate + 'a>,
+    pub blocks: Vec<std::ops::Range<u64>>,
+    /// What block indices count: "samples per pixel" or "passes".
+    pub unit: &'static str,
+}
+
+/// A run accumulated block by block: the one-machine run renders every block and adds it;
+/// a shard renders some and writes their sums; a merge adds every shard's sums in order.
+/// Both add with [`Accumulate::add`] from zero in block order, so they agree bit for bit.
+pub trait Accumulate {
+    /// The layers, in the order a block's sums come in.
+    fn layer_names(&self) -> Vec<String>;
+    /// f64 sums per pixel of `block` alone, per layer.
+    fn block(
+        &mut self,
+        block: std::ops::Range<u64>,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<Vec<Vec<glam::DVec3>>, String>;
+    /// Adds a block's sums (`n` indices of it).
+    fn add(&mut self, sums: &[Vec<glam::DVec3>], n: u64);
+    /// The run after every block was added; `seconds` the time its blocks took.
+    fn finish(&self, seconds: f64) -> Rendered;
+}
 
 /// The one `match` on `scene::Method`.
 pub fn spec(method: Method) -> MethodSpec {
@@ -138,8 +171,26 @@ pub fn spec(method: Method) -> MethodSpec {
             // One camera sample per pixel and pass; progress counts them.
             Method::Sppm => (sppm::render, false, false, false),
         };
+    let blocks: Result<BlocksFn, &'static str> = match method {
+        Method::Path => Ok(path::blocks),
+        Method::CausticSplat => Ok(caustic_splat::blocks),
+        Method::Sppm => Err(
+            "sppm's passes depend on each other (every pass shrinks the radii the next one \
+             gathers in), so no range of them can run apart: shard `caustic-splat` or \
+             `path`, or render independent seeds and `composite` them",
+        ),
+        Method::PathSplat => Err(
+            "path+splat interleaves two progressions: shard `path --no-caustics` and \
+             `caustic-splat` apart and `composite` the two merged runs",
+        ),
+        Method::GlobalDirect | Method::FinalGather => Err(
+            "the photon-map methods estimate from one photon map: shard `trace`, `merge` \
+             its photon sets into the cache, then `estimate`",
+        ),
+    };
     MethodSpec {
         render,
+        blocks,
         photon_maps,
         estimate_spp,
         splat_progress,

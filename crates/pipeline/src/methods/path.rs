@@ -24,6 +24,8 @@ pub(super) struct Progressive<'a> {
     sums: Vec<Vec<DVec3>>,
     /// Samples per pixel made so far.
     pub samples: u32,
+    /// Blocks (passes) added so far.
+    blocks: u32,
 }
 
 impl<'a> Progressive<'a> {
@@ -52,35 +54,63 @@ impl<'a> Progressive<'a> {
             sums: vec![vec![DVec3::ZERO; pixels]; parts.len()],
             parts,
             samples: 0,
+            blocks: 0,
         }
     }
 
-    /// Samples of the next pass of a run of `spp`: as many as made so far (at least one), at
-    /// most `spp / MIN_PASSES` rounded up to a power of two, so every power of two of
-    /// samples ends a pass.
+    /// Samples of the next pass of a run of `spp` (see [`next_pass`]).
     pub(super) fn next_pass(&self, spp: u32) -> u32 {
-        let cap = spp.div_ceil(MIN_PASSES).max(1).next_power_of_two();
-        self.samples.clamp(1, cap).min(spp - self.samples)
+        next_pass(self.samples, spp)
     }
 
-    /// Renders the next `n` samples of every pixel and adds them.
-    pub(super) fn step(&mut self, n: u32, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
+    /// The layers' names, in the order [`Progressive::block`] returns their sums.
+    pub(super) fn layer_names(&self) -> Vec<String> {
+        self.parts.iter().map(|p| p.name().to_string()).collect()
+    }
+
+    /// The f64 sums per pixel of samples `range` of every pixel, per layer: one pass, the unit
+    /// a shard renders and a merge adds.
+    pub(super) fn block(
+        &self,
+        range: std::ops::Range<u32>,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<Vec<Vec<DVec3>>, String> {
         let opts = eye::RenderOptions {
-            spp: n,
-            first_sample: self.samples,
+            spp: range.end - range.start,
+            first_sample: range.start,
             ..self.opts
         };
         let film = eye::render(self.run.scene, &opts, progress);
         let w = self.run.scene.camera.width as usize;
-        for (part, sums) in self.parts.iter().zip(&mut self.sums) {
-            let layer = film
-                .layer(part.name())
-                .ok_or_else(|| format!("the eye pass wrote no `{}` layer", part.name()))?;
-            for (i, s) in sums.iter_mut().enumerate() {
-                *s += DVec3::from_array(layer.sum(i % w, i / w));
+        let pixels = self.sums.first().map_or(0, Vec::len);
+        self.parts
+            .iter()
+            .map(|part| {
+                let layer = film
+                    .layer(part.name())
+                    .ok_or_else(|| format!("the eye pass wrote no `{}` layer", part.name()))?;
+                Ok((0..pixels)
+                    .map(|i| DVec3::from_array(layer.sum(i % w, i / w)))
+                    .collect())
+            })
+            .collect()
+    }
+
+    /// Adds a block of `n` samples per pixel ([`Progressive::block`]'s sums) to the image.
+    pub(super) fn add(&mut self, block: &[Vec<DVec3>], n: u32) {
+        for (sums, b) in self.sums.iter_mut().zip(block) {
+            for (s, v) in sums.iter_mut().zip(b) {
+                *s += *v;
             }
         }
         self.samples += n;
+        self.blocks += 1;
+    }
+
+    /// Renders the next `n` samples of every pixel and adds them.
+    pub(super) fn step(&mut self, n: u32, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
+        let block = self.block(self.samples..self.samples + n, progress)?;
+        self.add(&block, n);
         Ok(())
     }
 
@@ -134,6 +164,65 @@ impl<'a> Progressive<'a> {
                 count_kind: CountKind::Spp,
             })
             .collect()
+    }
+}
+
+/// Samples of the pass after `samples` of a run of `spp`: as many as made so far (at least
+/// one), at most `spp / MIN_PASSES` rounded up to a power of two, so every power of two of
+/// samples ends a pass.
+fn next_pass(samples: u32, spp: u32) -> u32 {
+    let cap = spp.div_ceil(MIN_PASSES).max(1).next_power_of_two();
+    samples.clamp(1, cap).min(spp - samples)
+}
+
+/// The sample ranges of a run of `spp`'s passes, in order: the blocks shards split and a
+/// merge adds in this order, as the one-machine run does.
+pub(super) fn passes(spp: u32) -> Vec<std::ops::Range<u64>> {
+    let mut out = Vec::new();
+    let mut done = 0;
+    while done < spp {
+        let n = next_pass(done, spp);
+        out.push(done as u64..(done + n) as u64);
+        done += n;
+    }
+    out
+}
+
+/// The path tracer's run as blocks: its passes ([`passes`]).
+pub(super) fn blocks<'a>(run: &'a Run<'a>) -> super::Blocks<'a> {
+    super::Blocks {
+        acc: Box::new(Progressive::new(run)),
+        blocks: passes(run.settings.render.spp),
+        unit: "samples per pixel",
+    }
+}
+
+impl super::Accumulate for Progressive<'_> {
+    fn layer_names(&self) -> Vec<String> {
+        Progressive::layer_names(self)
+    }
+
+    fn block(
+        &mut self,
+        block: std::ops::Range<u64>,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<Vec<Vec<DVec3>>, String> {
+        Progressive::block(self, block.start as u32..block.end as u32, progress)
+    }
+
+    fn add(&mut self, sums: &[Vec<DVec3>], n: u64) {
+        Progressive::add(self, sums, n as u32);
+    }
+
+    fn finish(&self, seconds: f64) -> Rendered {
+        Rendered {
+            layers: self.layers(),
+            plan: None,
+            info: self.facts(seconds, self.blocks),
+            passes: None,
+            samples: Some(self.samples),
+            snapshots: Vec::new(),
+        }
     }
 }
 
