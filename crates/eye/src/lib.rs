@@ -16,11 +16,16 @@
 //!   heuristic (Veach 1997 ch. 9). Shadow rays are blocked by glass and mirrors, so NEE never
 //!   produces caustics; a light reached by BSDF sampling through one or more specular bounces
 //!   after a diffuse vertex is therefore a caustic with MIS weight 1.
-//! - Pixel sample `s` of pixel `p` draws from `Rng::for_index(seed, s * pixels + p)`, tiles
-//!   accumulate in private f64 buffers merged in tile order, so the film is bit-identical for
-//!   any thread count (pbrt-v4 indexes samples by pixel and sample number the same way).
+//! - The path tracer's pixel sample `s` of pixel `p` draws from a [`math::SobolSampler`]
+//!   (padded Owen-scrambled Sobol, a pure function of seed, pixel, `s` and dimension; the
+//!   default) or `Rng::for_index(seed, s * pixels + p)` (`[render] sampler = "independent"`;
+//!   the photon methods' eye passes always), tiles accumulate in private f64 buffers merged in
+//!   tile order, so the film is bit-identical for any thread count (pbrt-v4 indexes samples
+//!   by pixel and sample number the same way).
+//! - Russian roulette from bounce `rr_depth` (5) judges the throughput times eta'^2 of the
+//!   refractions taken (pbrt-v4's `etaScale`), survival capped at 0.95 like Mitsuba 3.
 //! - Sampling takes its random numbers as arguments (`scene::LightTable::sample`); only the
-//!   path loop owns an [`math::Rng`].
+//!   path loop owns a [`math::Sampler`].
 
 mod path;
 mod photon;
