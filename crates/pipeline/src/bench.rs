@@ -132,9 +132,8 @@ fn peer_ratios(
         }
         let text = String::from_utf8_lossy(&out.stdout);
         for (i, (set, rays, _)) in sets.iter().enumerate() {
-            let rate = peer_rate(&text, set).ok_or_else(|| {
-                format!("peer {name}: no `{set} ... Mrays/s` line in its output")
-            })?;
+            let rate = peer_rate(&text, set)
+                .ok_or_else(|| format!("peer {name}: no `{set} ... Mrays/s` line in its output"))?;
             theirs[i].push(rate);
             ours[i].push(median_rate(&geo, rays, 1).0);
         }

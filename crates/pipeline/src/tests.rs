@@ -467,6 +467,12 @@ fn peer_ray_rates_are_read_from_their_lines() {
         incoherent (random o, random d)    rays 1,048,576  hits   882,790 ( 84.2%)  wall 0.495 s  cpu 0.245 s    2.12 Mrays/s\n";
     assert_eq!(crate::bench::peer_rate(out, "coherent"), Some(3.46));
     assert_eq!(crate::bench::peer_rate(out, "incoherent"), Some(2.12));
-    assert_eq!(crate::bench::peer_rate("  coherent: 7.5 M rays/s\n", "coherent"), Some(7.5));
-    assert_eq!(crate::bench::peer_rate("coherent rays only\n", "coherent"), None);
+    assert_eq!(
+        crate::bench::peer_rate("  coherent: 7.5 M rays/s\n", "coherent"),
+        Some(7.5)
+    );
+    assert_eq!(
+        crate::bench::peer_rate("coherent rays only\n", "coherent"),
+        None
+    );
 }
