@@ -6,14 +6,16 @@ use crate::{Rng, Sampler, SobolSampler};
 fn is_net(points: &[[u32; 2]], m: u32) -> bool {
     (0..=m).all(|a| {
         let mut seen = vec![false; 1 << m];
+        // The top `bits` bits of `v` (`>> 32` is not defined for u32, hence the case).
+        let top = |v: u32, bits: u32| {
+            if bits == 0 {
+                0
+            } else {
+                (v >> (32 - bits)) as usize
+            }
+        };
         points.iter().all(|&[x, y]| {
-            let cell = (((x >> (32 - a)) as usize) << (m - a)) | (y >> (32 - (m - a))) as usize;
-            // `>> 32` is not defined for u32: a = 0 or m - a = 0 means a single column/row.
-            let cell = match (a, m - a) {
-                (0, _) => (y >> (32 - m)) as usize,
-                (_, 0) => (x >> (32 - m)) as usize,
-                _ => cell,
-            };
+            let cell = (top(x, a) << (m - a)) | top(y, m - a);
             !std::mem::replace(&mut seen[cell], true)
         })
     })
