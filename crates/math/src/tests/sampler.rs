@@ -110,7 +110,6 @@ fn a_smooth_integral_converges_faster_than_with_independent_samples() {
         e_sobol < 0.1 * e_indep,
         "sobol {e_sobol}, independent {e_indep}"
     );
-    // And it stays unbiased: the mean over pixels is within a few standard errors.
 }
 
 #[test]
