@@ -168,9 +168,79 @@ impl<'a> Best<'a> {
         }
     }
 
+    /// Sorted by key, the k smallest.
     fn finish(mut self) {
         self.select();
-        self.out.sort_unstable_by_key(|n| n.key());
+        sort_neighbors(self.out);
+    }
+}
+
+/// Sort by `(d2, index)` in expected linear time: a bucket sort on d2 (Knuth, TAOCP vol. 3,
+/// §5.2.5, "distribution sorting"). On a surface, the k nearest's d2 is near uniform over
+/// [0, r_k²] (the area within r grows like r²), so `n` buckets over [0, max d2] hold about
+/// one point each; one counting pass and one scatter put every point in its bucket, and an
+/// insertion sort, whose work is the inversions left (within buckets only), finishes.
+/// Measured against `sort_unstable` (pattern-defeating quicksort, O(n log n)), which was
+/// the largest cost of a k = 250 query. Few points, d2 all zero or not finite, or a bucket
+/// with many ties (duplicate photons): `sort_unstable`.
+pub(crate) fn sort_neighbors(out: &mut Vec<Neighbor>) {
+    let n = out.len();
+    if n <= 32 {
+        out.sort_unstable_by_key(|n| n.key());
+    } else if n <= 256 {
+        sort_bucketed::<512>(out);
+    } else if n <= 1024 {
+        sort_bucketed::<2048>(out);
+    } else {
+        sort_bucketed::<4096>(out);
+    }
+}
+
+fn sort_bucketed<const B: usize>(out: &mut Vec<Neighbor>) {
+    let n = out.len();
+    let nb = (2 * n).min(B);
+    let hi = out.iter().fold(0f32, |m, n| m.max(n.d2));
+    let scale = nb as f32 / hi;
+    if !(scale.is_finite() && scale > 0.0) {
+        out.sort_unstable_by_key(|n| n.key());
+        return;
+    }
+    // d2 * scale in [0, nb] rounded to an integer by the magic-number trick of
+    // `keep_k_smallest` (monotone, no float-to-int conversion), clamped below nb.
+    const MAGIC: f32 = 8_388_608.0; // 2^23
+    let bucket = |d2: f32| {
+        ((d2 * scale + MAGIC).to_bits().wrapping_sub(MAGIC.to_bits()) as usize).min(nb - 1)
+    };
+    let mut start = [0u32; B];
+    for e in out.iter() {
+        start[bucket(e.d2)] += 1;
+    }
+    let (mut sum, mut most) = (0u32, 0u32);
+    for c in &mut start[..nb] {
+        most = most.max(*c);
+        (*c, sum) = (sum, sum + *c);
+    }
+    if most > 32 {
+        out.sort_unstable_by_key(|n| n.key());
+        return;
+    }
+    // Scatter from a copy in the spare tail.
+    out.extend_from_within(..);
+    for i in n..2 * n {
+        let e = out[i];
+        let b = bucket(e.d2);
+        out[start[b] as usize] = e;
+        start[b] += 1;
+    }
+    out.truncate(n);
+    for i in 1..n {
+        let e = out[i];
+        let mut j = i;
+        while j > 0 && out[j - 1].key() > e.key() {
+            out[j] = out[j - 1];
+            j -= 1;
+        }
+        out[j] = e;
     }
 }
 

@@ -438,3 +438,99 @@ each_index!(hinted_duplicates_all_at_one_point, |kind: IndexKind| {
         }
     }
 });
+
+// The depth-first search, now the radius-first search's fallback (and the leaves' density
+// estimate), still equals brute force on its own: surface photons with duplicates and a
+// clump, and a coarse grid where every distance is shared by many points.
+#[test]
+fn kd_tree_depth_first_equals_brute_force() {
+    let mut rng = Rng::new(13);
+    let mut sets: Vec<Vec<[f32; 3]>> = Vec::new();
+    let mut photons: Vec<[f32; 3]> = (0..10_000)
+        .map(|_| crate::bench::point_on_unit_cube(&mut rng))
+        .collect();
+    photons.extend_from_within(0..50);
+    photons.extend((0..200).map(|i| [0.5, 0.5, 1e-4 * (i % 7) as f32]));
+    sets.push(photons);
+    sets.push(
+        (0..4097)
+            .map(|_| crate::bench::point_on_unit_cube(&mut rng).map(|c| (c * 16.0).round() / 16.0))
+            .collect(),
+    );
+    let mut out = Vec::new();
+    for points in &sets {
+        let tree = crate::KdTree::build(points);
+        for i in 0..60 {
+            let q = if i % 2 == 0 {
+                Vec3::from(crate::bench::point_on_unit_cube(&mut rng))
+            } else {
+                Vec3::new(0.5, 0.5, 0.0)
+            };
+            for k in [1, 31, 250, 1000] {
+                for r_max in [f32::INFINITY, 0.05] {
+                    tree.knn_depth_first(q, k, r_max, &mut out);
+                    assert_eq!(
+                        out,
+                        reference(points, q, k, r_max),
+                        "q={q} k={k} r_max={r_max}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Density that changes a hundredfold within a leaf's reach: a dense patch on a sparse
+/// face, queried across its rim, where the radius guessed from the query's leaf is far
+/// too small (sparse side of the rim) or far too large (dense side), so the radius-first
+/// search must grow its radius or give up for the depth-first one, and still be exact.
+#[test]
+fn kd_tree_radius_guess_off_by_far_stays_exact() {
+    let mut rng = Rng::new(14);
+    let mut points: Vec<[f32; 3]> = (0..3000)
+        .map(|_| [rng.uniform(), rng.uniform(), 0.0])
+        .collect();
+    points.extend((0..30_000).map(|_| [0.4 + 0.2 * rng.uniform(), 0.4 + 0.2 * rng.uniform(), 0.0]));
+    let index = Index::build(crate::IndexKind::KdTree, &points);
+    let mut out = Vec::new();
+    for i in 0..200 {
+        // Along a line across the patch's rim at x = 0.4 and x = 0.6.
+        let q = Vec3::new(
+            0.3 + 0.4 * i as f32 / 199.0,
+            0.5 + 0.05 * rng.uniform(),
+            0.0,
+        );
+        for k in [1, 10, 50, 250, 1000] {
+            check(&index, &points, q, k, f32::INFINITY, &mut out);
+        }
+    }
+}
+
+/// The bucket sort orders by `(d2, index)` exactly like a comparison sort: uniform,
+/// clustered and tied distances (a bucket of more than 32 ties falls back), zeros, huge
+/// and infinite values, at every size tier.
+#[test]
+fn bucket_sort_equals_comparison_sort() {
+    let mut rng = Rng::new(15);
+    for n in [0usize, 1, 2, 31, 33, 100, 256, 257, 1000, 1025, 3000, 5000] {
+        for case in 0..6 {
+            let mut v: Vec<Neighbor> = (0..n)
+                .map(|i| Neighbor {
+                    index: rng.below(1 << 20) ^ i as u32,
+                    d2: match case {
+                        0 => rng.uniform(),
+                        1 => rng.uniform().powi(8),
+                        2 => (rng.below(5) as f32) * 0.25,
+                        3 => 0.0,
+                        4 => [0.0, 1e-30, 3e38, f32::INFINITY][rng.below(4) as usize],
+                        _ => 1.0 + (i % 3) as f32 * f32::EPSILON,
+                    },
+                })
+                .collect();
+            let mut want = v.clone();
+            want.sort_by_key(|n| n.key());
+            crate::index::sort_neighbors(&mut v);
+            assert_eq!(v, want, "n={n} case={case}");
+        }
+    }
+}
