@@ -49,7 +49,7 @@ fn depth_for(n: usize) -> u32 {
 }
 
 /// One leaf's squared distances, a loop over the SoA rows that vectorises.
-#[inline]
+#[inline(always)]
 fn leaf_d2(pts: &Points, lo: usize, hi: usize, q: [f32; 3]) -> [f32; LEAF] {
     let mut d2s = [f32::INFINITY; LEAF];
     let (xs, ys, zs) = (
@@ -202,8 +202,7 @@ impl KdTree {
         self.radius_first(qa, k, radius2(r_max), guess, out);
         // Sorting every candidate (about 1.5 k) and keeping the first k costs less than
         // selecting k first and sorting those.
-        sort_neighbors(out);
-        out.truncate(k);
+        sort_neighbors(out, k);
     }
 
     /// The exact k-NN by the depth-first search alone (the radius-first search's

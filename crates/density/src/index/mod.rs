@@ -169,36 +169,39 @@ impl<'a> Best<'a> {
     }
 
     /// Sorted by key, the k smallest.
-    fn finish(mut self) {
-        self.select();
-        sort_neighbors(self.out);
+    fn finish(self) {
+        self.out.truncate(self.len);
+        sort_neighbors(self.out, self.k);
     }
 }
 
-/// Sort by `(d2, index)` in expected linear time: a bucket sort on d2 (Knuth, TAOCP vol. 3,
+/// The k smallest by `(d2, index)`, sorted, in expected linear time: a bucket sort on d2 (Knuth, TAOCP vol. 3,
 /// §5.2.5, "distribution sorting"). On a surface, the k nearest's d2 is near uniform over
 /// [0, r_k²] (the area within r grows like r²), so `n` buckets over [0, max d2] hold about
 /// one point each; one counting pass and one scatter put every point in its bucket, and an
 /// insertion sort, whose work is the inversions left (within buckets only), finishes.
 /// Measured against `sort_unstable` (pattern-defeating quicksort, O(n log n)), which was
 /// the largest cost of a k = 250 query. Few points, d2 all zero or not finite, or a bucket
-/// with many ties (duplicate photons): `sort_unstable`.
-pub(crate) fn sort_neighbors(out: &mut Vec<Neighbor>) {
+/// with many ties (duplicate photons): `sort_unstable`. Buckets past the one holding the
+/// k-th point are not sorted.
+pub(crate) fn sort_neighbors(out: &mut Vec<Neighbor>, k: usize) {
     let n = out.len();
     if n <= 32 {
         out.sort_unstable_by_key(|n| n.key());
     } else if n <= 256 {
-        sort_bucketed::<512>(out);
+        sort_bucketed::<512>(out, k);
     } else if n <= 1024 {
-        sort_bucketed::<2048>(out);
+        sort_bucketed::<2048>(out, k);
     } else {
-        sort_bucketed::<4096>(out);
+        sort_bucketed::<4096>(out, k);
     }
+    out.truncate(k);
 }
 
-fn sort_bucketed<const B: usize>(out: &mut Vec<Neighbor>) {
+fn sort_bucketed<const B: usize>(out: &mut Vec<Neighbor>, k: usize) {
     let n = out.len();
-    let nb = (2 * n).min(B);
+    // Twice as many buckets as points: fewer share one, fewer inversions to undo.
+    let nb = (2 * n).min(B - 1);
     let hi = out.iter().fold(0f32, |m, n| m.max(n.d2));
     let scale = nb as f32 / hi;
     if !(scale.is_finite() && scale > 0.0) {
@@ -215,25 +218,39 @@ fn sort_bucketed<const B: usize>(out: &mut Vec<Neighbor>) {
     for e in out.iter() {
         start[bucket(e.d2)] += 1;
     }
-    let (mut sum, mut most) = (0u32, 0u32);
-    for c in &mut start[..nb] {
+    // Bucket starts, and `cut`: the bucket holding the k-th smallest. Later buckets
+    // cannot hold any of the first k, so they are not sorted.
+    let (mut sum, mut most, mut cut) = (0u32, 0u32, nb - 1);
+    for (b, c) in start[..nb].iter_mut().enumerate() {
         most = most.max(*c);
         (*c, sum) = (sum, sum + *c);
+        if (*c as usize) < k && sum as usize >= k {
+            cut = b;
+        }
     }
     if most > 32 {
         out.sort_unstable_by_key(|n| n.key());
         return;
     }
+    // Points in buckets up to `cut`, and one slot past them that points beyond `cut` all
+    // overwrite (branch-free).
+    let kept = if cut + 1 < nb {
+        start[cut + 1]
+    } else {
+        n as u32
+    };
+    start[cut + 1] = kept;
     // Scatter from a copy in the spare tail.
     out.extend_from_within(..);
     for i in n..2 * n {
         let e = out[i];
         let b = bucket(e.d2);
-        out[start[b] as usize] = e;
-        start[b] += 1;
+        let slot = b.min(cut + 1);
+        out[start[slot] as usize] = e;
+        start[slot] += (b <= cut) as u32;
     }
-    out.truncate(n);
-    for i in 1..n {
+    out.truncate(kept as usize);
+    for i in 1..out.len() {
         let e = out[i];
         let mut j = i;
         while j > 0 && out[j - 1].key() > e.key() {

@@ -514,7 +514,7 @@ fn bucket_sort_equals_comparison_sort() {
     let mut rng = Rng::new(15);
     for n in [0usize, 1, 2, 31, 33, 100, 256, 257, 1000, 1025, 3000, 5000] {
         for case in 0..6 {
-            let mut v: Vec<Neighbor> = (0..n)
+            let v: Vec<Neighbor> = (0..n)
                 .map(|i| Neighbor {
                     index: rng.below(1 << 20) ^ i as u32,
                     d2: match case {
@@ -529,8 +529,11 @@ fn bucket_sort_equals_comparison_sort() {
                 .collect();
             let mut want = v.clone();
             want.sort_by_key(|n| n.key());
-            crate::index::sort_neighbors(&mut v);
-            assert_eq!(v, want, "n={n} case={case}");
+            for k in [n, n / 2, 1] {
+                let mut got = v.clone();
+                crate::index::sort_neighbors(&mut got, k);
+                assert_eq!(got, want[..k.min(n)], "n={n} case={case} k={k}");
+            }
         }
     }
 }
