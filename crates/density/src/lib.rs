@@ -10,10 +10,12 @@
 //! within it, in the same order — so the back-ends (our kd-tree, kiddo, brute force) are
 //! interchangeable and tested for equality with brute force, and an estimate never depends
 //! on which one ran. Use our kd-tree: built in place over f32 positions with u32 ids (no
-//! node structs, positions hot and ids cold) and collecting neighbours by buffered
-//! selection, it was the fastest at 1M photons on a cube's faces for k from 50 to 1000
-//! (`bench::bench_knn`), ahead of kiddo 5's `ImmutableKdTree`, with brute force far
-//! behind; both trees build equally fast. Measurements: docs/benchmarks.md.
+//! node structs, positions hot and ids cold), searching radius-first (a range search at a
+//! radius guessed from the density stored per leaf, then a bucket sort of the candidates;
+//! depth-first search with buffered selection when the guess fails), it was the fastest at
+//! 1M photons on a cube's faces for k from 50 to 1000 (`bench::bench_knn`), ahead of
+//! kiddo 5's `ImmutableKdTree`, with brute force far behind; ours also builds faster.
+//! Measurements: docs/benchmarks.md.
 //!
 //! Second decision: kernels are normalised over the unit disc and the estimate is
 //! E = (1/r²) Σ Φ_p K(d_p/r) in f64; r is the k-th distance over *all* candidates, and

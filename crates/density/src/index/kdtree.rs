@@ -1,5 +1,6 @@
-//! Our kd-tree: in place over SoA f32 positions with u32 ids, k-NN by buffered selection,
-//! radius-first k-NN from a hint, and a fixed-radius range search.
+//! Our kd-tree: in place over SoA f32 positions with u32 ids, k-NN radius-first (from the
+//! leaf's density or a hint; depth-first with buffered selection as the fallback), and a
+//! fixed-radius range search.
 
 use super::{Best, KnnHint, Neighbor, Points, dist2, keep_k_smallest, radius2, sort_neighbors};
 use glam::Vec3;
