@@ -137,11 +137,18 @@ impl Geometry {
 
     /// Closest hit with `0 < t < ray.t_max`.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        let (t, prim) = match &self.accel {
-            Accel::Bvh4(b) => b.intersect(ray, &self.spheres)?,
-            _ => self.intersect_cwbvh(ray)?,
-        };
+        let (t, prim) = self.closest(ray)?;
         Some(self.hit(ray, prim, t))
+    }
+
+    /// The closest hit with `0 < t < ray.t_max` as its distance and primitive only, the
+    /// query a ray-casting kernel such as Embree's `rtcIntersect1` answers; [`Geometry::intersect`]
+    /// adds the surface record (point and its error bound, normals, uv).
+    pub fn closest(&self, ray: &Ray) -> Option<(f32, Prim)> {
+        match &self.accel {
+            Accel::Bvh4(b) => b.intersect(ray, &self.spheres),
+            _ => self.intersect_cwbvh(ray),
+        }
     }
 
     fn hit(&self, ray: &Ray, prim: Prim, t: f32) -> Hit {

@@ -92,17 +92,19 @@ impl RayData {
         };
         let kx = (kz + 1) % 3;
         let ky = (kx + 1) % 3;
+        // The six divisions in one vector division (each lane rounds like the scalar
+        // quotient): 1/dx, 1/dy, 1/dz, and the shear's -dkx/dkz, -dky/dkz; 1/dkz is one of
+        // the first three.
+        let q = F4::new(1.0, 1.0, 1.0, -d[kx]).div(F4::new(d[0], d[1], d[2], d[kz]));
+        let sy = -d[ky] / d[kz];
+        let q = q.to_array();
         RayData {
             o: o.map(F4::splat),
-            inv: d.map(|x| F4::splat(1.0 / x)),
+            inv: [q[0], q[1], q[2]].map(F4::splat),
             near: [neg[0], 2 + neg[1], 4 + neg[2]],
             far: [1 - neg[0], 3 - neg[1], 5 - neg[2]],
             k: [kx, ky, kz],
-            s: [
-                F4::splat(-d[kx] / d[kz]),
-                F4::splat(-d[ky] / d[kz]),
-                F4::splat(1.0 / d[kz]),
-            ],
+            s: [F4::splat(q[3]), F4::splat(sy), F4::splat(q[kz])],
         }
     }
 
@@ -376,6 +378,20 @@ impl Bvh4 {
                     // Visit the nearest child first; push the others far to near
                     // (Wald et al. 2008, "Getting rid of packets", ordered traversal).
                     let tn = tn.to_array();
+                    let rest = mask & (mask - 1);
+                    if rest & (rest - 1) == 0 {
+                        // Two children, the common case: one comparison.
+                        let (i, j) = (
+                            mask.trailing_zeros() as usize,
+                            rest.trailing_zeros() as usize,
+                        );
+                        // Ties go to the later child, as in the general case's insertion sort.
+                        let (near, far) = if tn[i] < tn[j] { (i, j) } else { (j, i) };
+                        stack[sp] = (n.child[far], tn[far]);
+                        sp += 1;
+                        cur = n.child[near];
+                        continue;
+                    }
                     let mut c = [(0u32, 0f32); 4];
                     let mut k = 0;
                     let mut m = mask;
