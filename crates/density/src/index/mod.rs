@@ -208,12 +208,8 @@ fn sort_bucketed<const B: usize>(out: &mut Vec<Neighbor>, k: usize) {
         out.sort_unstable_by_key(|n| n.key());
         return;
     }
-    // d2 * scale in [0, nb] rounded to an integer by the magic-number trick of
-    // `keep_k_smallest` (monotone, no float-to-int conversion), clamped below nb.
-    const MAGIC: f32 = 8_388_608.0; // 2^23
-    let bucket = |d2: f32| {
-        ((d2 * scale + MAGIC).to_bits().wrapping_sub(MAGIC.to_bits()) as usize).min(nb - 1)
-    };
+    // d2 * scale is in [0, nb]; clamped below nb.
+    let bucket = |d2: f32| round_small(d2 * scale).min(nb - 1);
     let mut start = [0u32; B];
     for e in out.iter() {
         start[bucket(e.d2)] += 1;
@@ -261,6 +257,15 @@ fn sort_bucketed<const B: usize>(out: &mut Vec<Neighbor>, k: usize) {
     }
 }
 
+/// `v` rounded to an integer, for 0 <= v <= 2^22, without a float-to-integer conversion:
+/// v + 2^23 has exponent 23, so its low mantissa bits are v rounded (the usual "magic
+/// number" trick). Monotone like the floor, which is all bucketing needs.
+#[inline(always)]
+fn round_small(v: f32) -> usize {
+    const MAGIC: f32 = 8_388_608.0; // 2^23
+    (v + MAGIC).to_bits().wrapping_sub(MAGIC.to_bits()) as usize
+}
+
 /// Keep the k smallest `(d2, index)` of `out`, in their order. Selection by bucketing:
 /// d2 ↦ round(256 d2 / max d2) is monotone, so counting per bucket finds the bucket holding
 /// the k-th key in one pass; only that bucket (a few points, as d2 is near uniform on a
@@ -268,14 +273,10 @@ fn sort_bucketed<const B: usize>(out: &mut Vec<Neighbor>, k: usize) {
 /// "Fast k-selection algorithms for graphics processing units", bucket select): one
 /// counting pass instead of introselect's repeated partitions of all candidates.
 ///
-/// The bucket is computed without a float-to-integer conversion: for 0 <= v <= 2^22,
-/// v + 2^23 has exponent 23, so its low mantissa bits are v rounded to an integer (the
-/// usual "magic number" trick). Rounding is monotone like the floor, which is all the
-/// selection needs. Two histograms, alternating, so runs of equal buckets (neighbouring
-/// points in slot order) do not serialise on one counter.
+/// The bucket is computed by [`round_small`]. Two histograms, alternating, so runs of
+/// equal buckets (neighbouring points in slot order) do not serialise on one counter.
 fn keep_k_smallest(out: &mut Vec<Neighbor>, k: usize) {
     const B: usize = 256;
-    const MAGIC: f32 = 8_388_608.0; // 2^23
     let m = out.len();
     if m <= k {
         return;
@@ -283,8 +284,7 @@ fn keep_k_smallest(out: &mut Vec<Neighbor>, k: usize) {
     let hi = out.iter().fold(0f32, |a, n| a.max(n.d2));
     let scale = B as f32 / hi;
     // In 0..=B (d2 * scale <= B up to rounding, which rounds to B at most): B + 1 buckets.
-    let bucket =
-        |d2: f32| ((d2 * scale + MAGIC).to_bits().wrapping_sub(MAGIC.to_bits()) as usize) & 511;
+    let bucket = |d2: f32| round_small(d2 * scale) & 511;
     let below = if scale.is_finite() && scale > 0.0 {
         let mut counts = [[0u32; 512]; 2];
         let mut pairs = out.chunks_exact(2);
