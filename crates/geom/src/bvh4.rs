@@ -1,6 +1,7 @@
 //! The default acceleration structure: a 4-wide BVH with full-precision f32 child boxes in
 //! structure-of-arrays layout (one SSE compare tests all four children), collapsed from an
-//! obvhs `Bvh2` (PLOC + reinsertion). Triangles *and* spheres are its primitives, so a ray
+//! obvhs `Bvh2` (PLOC + reinsertion) by the collapse that minimises the surface area
+//! heuristic (dynamic programming, `Builder::optimize`). Triangles *and* spheres are its primitives, so a ray
 //! pays for a sphere only when it enters the sphere's box.
 //!
 //! Leaves hold up to `LEAF_MAX` triangles in blocks of four, tested together with the
@@ -27,7 +28,8 @@ const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 const EMPTY: u32 = u32::MAX;
 
 /// Largest triangle leaf: one block of four. On the tessellated Cornell scene (`bench-rays`,
-/// one run, medians of 3) 2 and 8 were 10-15% slower on both ray sets.
+/// one run, medians of 3) 2 and 8 were 10-15% slower on both ray sets with the greedy
+/// collapse; with the optimal one 8 measured the same as 4.
 const LEAF_MAX: u32 = 4;
 
 /// Ize, "Robust BVH Ray Traversal" (JCGT 2013): scaling the exit distance by
@@ -167,32 +169,31 @@ impl RayData {
         if mask == 0 {
             return (0, [0.0; 4]);
         }
-        let inv_det = F4::splat(1.0).div(det);
-        let t = ts.mul(inv_det);
+        // pbrt-v4's conservative bound on the error of t (§6.8.7), multiplied through by |det|
+        // so that the test `dt < t` waits for no division, and with its terms gathered
+        // (the bound's dependency chain was 13% of an incoherent ray in `bench-rays`):
+        // dz = g3 max_z, dx = g5 (max_x + max_z), dy = g5 (max_y + max_z),
+        // de = 2 (g2 max_x max_y + dy max_x + dx max_y)
+        //    = 2 ((g2 + 2 g5) max_x max_y + g5 max_z (max_x + max_y)),
+        // dt |det| = 3 (g3 max_e max_z + de max_z + dz max_e) = 3 max_z (2 g3 max_e + de).
         let max3 = |a: F4, b: F4, c: F4| a.abs().max_into(b.abs().max_into(c.abs()));
         let max_z = max3(z0, z1, z2);
         let max_x = max3(x0, x1, x2);
         let max_y = max3(y0, y1, y2);
         let max_e = max3(e0, e1, e2);
         let g = |n: i32| F4::splat(gamma(n));
-        let dz = g(3).mul(max_z);
-        let dx = g(5).mul(max_x.add(max_z));
-        let dy = g(5).mul(max_y.add(max_z));
-        let de = F4::splat(2.0).mul(
-            g(2).mul(max_x)
-                .mul(max_y)
-                .add(dy.mul(max_x))
-                .add(dx.mul(max_y)),
-        );
-        let dt = F4::splat(3.0)
-            .mul(
-                g(3).mul(max_e)
-                    .mul(max_z)
-                    .add(de.mul(max_z))
-                    .add(dz.mul(max_e)),
-            )
-            .mul(inv_det.abs());
-        mask &= dt.lt(t) & t.lt(F4::splat(t_max));
+        let de_half = g(2)
+            .add(F4::splat(2.0).mul(g(5)))
+            .mul(max_x.mul(max_y))
+            .add(g(5).mul(max_z).mul(max_x.add(max_y)));
+        let dt_det = F4::splat(6.0).mul(max_z).mul(g(3).mul(max_e).add(de_half));
+        // ts carries the sign of det in every lane still in the mask.
+        mask &= dt_det.lt(ts.abs());
+        if mask == 0 {
+            return (0, [0.0; 4]);
+        }
+        let t = ts.div(det);
+        mask &= t.lt(F4::splat(t_max));
         (mask, t.to_array())
     }
 }
@@ -268,8 +269,8 @@ impl Bvh4 {
             bvh2: &bvh2,
             n_tri: n_tri as u32,
             mesh,
-            count: vec![0; bvh2.nodes.len()],
-            has_sphere: vec![false; bvh2.nodes.len()],
+            cost: vec![[0.0; 4]; bvh2.nodes.len()],
+            choice: vec![[Choice::Leaf; 4]; bvh2.nodes.len()],
             out: Bvh4 {
                 nodes: Vec::new(),
                 tris: Vec::new(),
@@ -278,7 +279,7 @@ impl Bvh4 {
                 stack_need: 1,
             },
         };
-        b.stats(0);
+        b.optimize(0);
         let (root, depth) = b.emit(0);
         b.out.root = root;
         b.out.stack_need = 3 * depth + 1;
@@ -476,57 +477,125 @@ impl Bvh4 {
     }
 }
 
+/// Relative costs of the collapse's surface area heuristic: visiting a node (one 4-wide box
+/// test) and testing one leaf block (four triangles) or a sphere, per unit of area.
+/// Relative costs of the collapse's surface area heuristic, per unit of area: visiting a node
+/// (one 4-wide box test), testing a leaf block (four triangles) or a sphere. A block costing
+/// 1, 2 or 3 node visits measured the same in `bench-rays` (pinned, 5 alternating rounds).
+const COST_NODE: f32 = 1.0;
+const COST_BLOCK: f32 = 1.0;
+const COST_SPHERE: f32 = 1.0;
+
+/// What the collapse decided for one Bvh2 node and a number of slots.
+#[derive(Clone, Copy, Default)]
+enum Choice {
+    /// One slot: the subtree becomes one leaf.
+    #[default]
+    Leaf,
+    /// One slot: the subtree becomes one 4-wide node whose children are the forests of
+    /// `left` in `k` slots and `right` in `4 - k`.
+    Node(u8),
+    /// `i` slots: `left` fills `k` of them and `right` the rest.
+    Split(u8),
+    /// `i` slots: no better than `i - 1` slots.
+    Fewer,
+}
+
 struct Builder<'a> {
     bvh2: &'a Bvh2,
     /// Primitives `0..n_tri` are triangles, the rest spheres.
     n_tri: u32,
     mesh: &'a TriMesh,
-    /// Primitives under each Bvh2 node.
-    count: Vec<u32>,
-    has_sphere: Vec<bool>,
+    /// Per Bvh2 node and slot count `i` (index `i - 1`): least SAH cost of the subtree as a
+    /// forest of at most `i` subtrees, and the choice that reaches it.
+    cost: Vec<[f32; 4]>,
+    choice: Vec<[Choice; 4]>,
     out: Bvh4,
 }
 
 impl Builder<'_> {
-    fn stats(&mut self, ni: usize) {
-        let n = self.bvh2.nodes[ni];
-        if n.prim_count > 0 {
-            let prims = &self.bvh2.primitive_indices
-                [n.first_index as usize..(n.first_index + n.prim_count) as usize];
-            self.count[ni] = n.prim_count;
-            self.has_sphere[ni] = prims.iter().any(|&p| p >= self.n_tri);
-        } else {
-            let (l, r) = (n.first_index as usize, n.first_index as usize + 1);
-            self.stats(l);
-            self.stats(r);
-            self.count[ni] = self.count[l] + self.count[r];
-            self.has_sphere[ni] = self.has_sphere[l] || self.has_sphere[r];
-        }
+    fn children(&self, ni: usize) -> Option<(usize, usize)> {
+        let n = &self.bvh2.nodes[ni];
+        (n.prim_count == 0).then(|| (n.first_index as usize, n.first_index as usize + 1))
     }
 
-    /// A subtree becomes one leaf: a lone sphere, or few enough triangles.
-    fn is_leaf(&self, ni: usize) -> bool {
-        let n = &self.bvh2.nodes[ni];
-        (n.prim_count > 0 && self.count[ni] == 1)
-            || (!self.has_sphere[ni] && self.count[ni] <= LEAF_MAX)
+    /// The optimal collapse of a binary BVH into a wide one by dynamic programming over
+    /// (node, slots), Ylitie, Karras and Laine, "Efficient Incoherent Ray Traversal on GPUs
+    /// Through Compressed Wide BVHs" (HPG 2017) §4.1, with our leaf rule: one sphere, or up
+    /// to `LEAF_MAX` triangles. Returns the subtree's primitive count and whether it holds a
+    /// sphere.
+    fn optimize(&mut self, ni: usize) -> (u32, bool) {
+        let node = self.bvh2.nodes[ni];
+        let area = node.aabb().half_area();
+        let Some((l, r)) = self.children(ni) else {
+            let p = self.bvh2.primitive_indices[node.first_index as usize];
+            let is_sphere = p >= self.n_tri;
+            let c = area * if is_sphere { COST_SPHERE } else { COST_BLOCK };
+            self.cost[ni] = [c; 4];
+            self.choice[ni] = [Choice::Leaf; 4];
+            return (1, is_sphere);
+        };
+        let (nl, sl) = self.optimize(l);
+        let (nr, sr) = self.optimize(r);
+        let (count, sphere) = (nl + nr, sl || sr);
+        let (cl, cr) = (self.cost[l], self.cost[r]);
+        // Best split of `i` slots between the two children.
+        let split = |i: usize| {
+            (1..i)
+                .map(|k| (cl[k - 1] + cr[i - k - 1], k as u8))
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .expect("i >= 2")
+        };
+        let (inner, k) = split(4);
+        let mut best = (area * COST_NODE + inner, Choice::Node(k));
+        if !sphere && count <= LEAF_MAX {
+            let leaf = area * COST_BLOCK * count.div_ceil(4) as f32;
+            if leaf <= best.0 {
+                best = (leaf, Choice::Leaf);
+            }
+        }
+        let mut cost = [best.0; 4];
+        let mut choice = [best.1; 4];
+        for i in 2..=4 {
+            let (c, k) = split(i);
+            (cost[i - 1], choice[i - 1]) = if c < cost[i - 2] {
+                (c, Choice::Split(k))
+            } else {
+                (cost[i - 2], Choice::Fewer)
+            };
+        }
+        self.cost[ni] = cost;
+        self.choice[ni] = choice;
+        (count, sphere)
+    }
+
+    /// The roots of the forest that stands for subtree `ni` in `i` slots.
+    fn forest(&self, ni: usize, i: usize, out: &mut Vec<usize>) {
+        match self.choice[ni][i - 1] {
+            Choice::Leaf | Choice::Node(_) => out.push(ni),
+            Choice::Fewer => self.forest(ni, i - 1, out),
+            Choice::Split(k) => {
+                let (l, r) = self.children(ni).expect("a split node has children");
+                self.forest(l, k as usize, out);
+                self.forest(r, i - k as usize, out);
+            }
+        }
     }
 
     fn prims(&self, ni: usize, out: &mut Vec<u32>) {
-        let n = self.bvh2.nodes[ni];
-        if n.prim_count > 0 {
-            out.extend_from_slice(
-                &self.bvh2.primitive_indices
-                    [n.first_index as usize..(n.first_index + n.prim_count) as usize],
-            );
-        } else {
-            self.prims(n.first_index as usize, out);
-            self.prims(n.first_index as usize + 1, out);
+        match self.children(ni) {
+            None => out.push(self.bvh2.primitive_indices[self.bvh2.nodes[ni].first_index as usize]),
+            Some((l, r)) => {
+                self.prims(l, out);
+                self.prims(r, out);
+            }
         }
     }
 
-    /// Emits the subtree under Bvh2 node `ni`; returns its reference and depth in nodes.
+    /// Emits the subtree under Bvh2 node `ni` as its one-slot choice; returns its reference
+    /// and depth in nodes.
     fn emit(&mut self, ni: usize) -> (u32, usize) {
-        if self.is_leaf(ni) {
+        let Choice::Node(k) = self.choice[ni][0] else {
             let mut prims = Vec::new();
             self.prims(ni, &mut prims);
             if prims[0] >= self.n_tri {
@@ -556,26 +625,11 @@ impl Builder<'_> {
                 "too many triangles for the BVH4 leaf encoding"
             );
             return (LEAF | (blocks << COUNT_SHIFT) | first, 0);
-        }
-        // Open the largest child until four (the usual BVH2 -> BVH4 collapse by surface area,
-        // Wald et al. 2008 "Getting rid of packets" §3).
-        let first = self.bvh2.nodes[ni].first_index as usize;
-        let mut kids = vec![first, first + 1];
-        while kids.len() < 4 {
-            let open = kids
-                .iter()
-                .enumerate()
-                .filter(|(_, k)| !self.is_leaf(**k) && self.bvh2.nodes[**k].prim_count == 0)
-                .max_by(|a, b| {
-                    let area = |k: usize| self.bvh2.nodes[k].aabb().half_area();
-                    area(*a.1).total_cmp(&area(*b.1))
-                })
-                .map(|(i, _)| i);
-            let Some(i) = open else { break };
-            let k = self.bvh2.nodes[kids[i]].first_index as usize;
-            kids[i] = k;
-            kids.push(k + 1);
-        }
+        };
+        let (l, r) = self.children(ni).expect("an inner node has children");
+        let mut kids = Vec::with_capacity(4);
+        self.forest(l, k as usize, &mut kids);
+        self.forest(r, 4 - k as usize, &mut kids);
         let idx = self.out.nodes.len();
         self.out.nodes.push(Node4 {
             b: [
