@@ -43,10 +43,12 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
   bench ...           updates docs/benchmarks.md: each benchmark builds with the release-lto
                       profile, echoes its output and records it (command, date, machine) as
                       its own section, replacing that section's previous run
-  bench rays [SCENE] [--runs N] [--compare]
+  bench rays [SCENE] [--runs N] [--compare] [--ray-dir DIR] [--peer NAME=CMD]
                       single-thread rays/s: 1M coherent camera rays and 1M incoherent rays
                       (default scene: scenes/cornell-spheres/tessellated.toml);
-                      --compare also measures the binary BVH (Bvh2) next to CwBvh
+                      --compare also measures obvhs' CwBvh next to the default BVH4;
+                      --ray-dir casts a peer's saved rays, --peer times the peer alternately
+                      (run under `taskset -c N` so both share one core)
   bench photons [SCENE] [--photons N] [--runs N]
                       photon paths/s on 1 and 2 threads (tracing alone and into photon files)
   bench store [--photons N]

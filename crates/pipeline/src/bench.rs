@@ -62,6 +62,11 @@ pub fn rays(
         ray_dir.map_or(String::new(), |d| format!(" from {}", d.display())),
         runs
     );
+    if let Some(cpus) = allowed_cpus() {
+        // A peer started from here inherits this set: run under `taskset -c N` so that both
+        // are timed on the same core (the Embree script pins itself to the first it may use).
+        println!("CPUs this process may run on: {cpus}");
+    }
     let mut kinds = vec![BvhKind::Bvh4];
     if compare {
         kinds.push(BvhKind::CwBvh);
@@ -148,6 +153,15 @@ fn peer_ratios(
         );
     }
     Ok(())
+}
+
+/// `Cpus_allowed_list` from `/proc/self/status` (Linux), e.g. `0-1` or `1`.
+fn allowed_cpus() -> Option<String> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("Cpus_allowed_list:"))
+        .map(|v| v.trim().to_string())
 }
 
 /// The rate on the first line that starts with `set` (after spaces) and holds `Mrays/s`.
