@@ -9,6 +9,7 @@ use crate::index::{Index, IndexKind, Neighbor};
 use glam::Vec3;
 use math::Rng;
 use std::hint::black_box;
+use std::num::NonZero;
 use std::time::Instant;
 
 const RUNS: usize = 3;
@@ -16,8 +17,9 @@ const RUNS: usize = 3;
 #[derive(Clone, Copy, Debug)]
 pub struct KnnBench {
     pub index: IndexKind,
-    /// The index's name, or "kiddo_raw": kiddo's own `nearest_n` (sorted by distance, no
-    /// tie rule), the fairest figure for kiddo.
+    /// The index's name, or "kiddo_raw": kiddo 5's own `nearest_n` (sorted by distance, no
+    /// tie rule), the fairest figure for kiddo; "kiddo6_raw": the same query in kiddo 6,
+    /// its newest release (the stable build: its SIMD paths need a nightly compiler).
     pub name: &'static str,
     pub photons: usize,
     pub k: usize,
@@ -58,24 +60,35 @@ pub fn bench_knn(photons: usize, ks: &[usize], queries: usize, seed: u64) -> Vec
             (index, t0.elapsed().as_secs_f64())
         })
         .collect();
-    // (index, kiddo's own query?)
-    let mut runs: Vec<(&Index, f64, bool)> = built.iter().map(|(i, t)| (i, *t, false)).collect();
+    let t0 = Instant::now();
+    let kiddo6 = kiddo6::ImmutableKdTree::<f32, 3>::new_from_slice(&points);
+    let kiddo6 = kiddo6.map(|t| (t, t0.elapsed().as_secs_f64()));
+    let mut runs: Vec<Run> = built.iter().map(|(i, t)| Run::Index(i, *t)).collect();
     if let Some((ki, t)) = built.iter().find(|(i, _)| i.kind() == IndexKind::Kiddo) {
-        runs.insert(2, (ki, *t, true));
+        runs.insert(2, Run::KiddoRaw(ki, *t));
+    }
+    if let Ok((tree, t)) = &kiddo6 {
+        runs.insert(3, Run::Kiddo6Raw(tree, *t));
     }
     let mut out = Vec::new();
     for &k in ks {
         let mut scratch: Vec<Neighbor> = Vec::with_capacity(k + 1);
         let mut times = vec![Vec::new(); runs.len()];
+        let k1 = NonZero::new(k).unwrap_or(NonZero::<usize>::MIN);
         for _ in 0..RUNS {
-            for (&(index, _, raw), t) in runs.iter().zip(times.iter_mut()) {
-                let nq = queries_for(index.kind(), photons, qs.len());
+            for (run, t) in runs.iter().zip(times.iter_mut()) {
+                let nq = queries_for(run.kind(), photons, qs.len());
                 let t0 = Instant::now();
                 let mut acc = 0usize;
                 for &q in &qs[..nq] {
-                    acc += match (raw, index) {
-                        (true, Index::Kiddo(kd)) => kd.nearest_n_raw(q, k),
-                        _ => {
+                    acc += match run {
+                        Run::KiddoRaw(Index::Kiddo(kd), _) => kd.nearest_n_raw(q, k),
+                        Run::Kiddo6Raw(tree, _) => tree
+                            .query(&q.to_array())
+                            .nearest_n::<kiddo6::SquaredEuclidean<f32>>(k1)
+                            .execute()
+                            .len(),
+                        Run::Index(index, _) | Run::KiddoRaw(index, _) => {
                             index.knn(q, k, f32::INFINITY, &mut scratch);
                             scratch.len()
                         }
@@ -85,16 +98,17 @@ pub fn bench_knn(photons: usize, ks: &[usize], queries: usize, seed: u64) -> Vec
                 t.push(t0.elapsed().as_secs_f64());
             }
         }
-        for (&(index, build_s, raw), mut t) in runs.iter().zip(times) {
+        for (run, mut t) in runs.iter().zip(times) {
             t.sort_by(f64::total_cmp);
-            let nq = queries_for(index.kind(), photons, qs.len());
+            let nq = queries_for(run.kind(), photons, qs.len());
+            let (name, build_s) = match run {
+                Run::Index(i, b) => (i.kind().name(), *b),
+                Run::KiddoRaw(_, b) => ("kiddo_raw", *b),
+                Run::Kiddo6Raw(_, b) => ("kiddo6_raw", *b),
+            };
             out.push(KnnBench {
-                index: index.kind(),
-                name: if raw {
-                    "kiddo_raw"
-                } else {
-                    index.kind().name()
-                },
+                index: run.kind(),
+                name,
                 photons,
                 k,
                 queries: nq,
@@ -104,6 +118,22 @@ pub fn bench_knn(photons: usize, ks: &[usize], queries: usize, seed: u64) -> Vec
         }
     }
     out
+}
+
+/// One timed contender: an index through our `knn`, or kiddo 5's or 6's own `nearest_n`.
+enum Run<'a> {
+    Index(&'a Index, f64),
+    KiddoRaw(&'a Index, f64),
+    Kiddo6Raw(&'a kiddo6::ImmutableKdTree<f32, 3>, f64),
+}
+
+impl Run<'_> {
+    fn kind(&self) -> IndexKind {
+        match self {
+            Run::Index(i, _) | Run::KiddoRaw(i, _) => i.kind(),
+            Run::Kiddo6Raw(..) => IndexKind::Kiddo,
+        }
+    }
 }
 
 /// Queries timed per pass: all of them, but brute force is capped at ~2e8 distance

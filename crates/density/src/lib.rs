@@ -14,7 +14,8 @@
 //! radius guessed from the density stored per leaf, then a bucket sort of the candidates;
 //! depth-first search with buffered selection when the guess fails), it was the fastest at
 //! 1M photons on a cube's faces for k from 50 to 1000 (`bench::bench_knn`), ahead of
-//! kiddo 5's `ImmutableKdTree`, with brute force far behind; ours also builds faster.
+//! kiddo's `ImmutableKdTree` (releases 5 and 6), with brute force far behind; ours also
+//! builds faster.
 //! Measurements: docs/benchmarks.md.
 //!
 //! Second decision: kernels are normalised over the unit disc and the estimate is

@@ -470,11 +470,31 @@ pub fn store(photons: usize, dir: &Path) -> Result<(), String> {
 /// k-NN queries per second over synthetic photons on the faces of a unit cube, per index.
 pub fn knn(photons: usize, queries: usize) -> Result<(), String> {
     println!("{photons} photons on the unit cube's faces, {queries} queries, 1 thread");
-    for r in density::bench::bench_knn(photons, &[50, 250, 1000], queries, 7) {
+    let rows = density::bench::bench_knn(photons, &[50, 250, 1000], queries, 7);
+    for r in &rows {
         println!(
-            "{:>9} k = {:4}: {:10.0} queries/s (build {:.3} s)",
+            "{:>10} k = {:4}: {:10.0} queries/s (build {:.3} s)",
             r.name, r.k, r.queries_per_s, r.build_s
         );
+    }
+    // Ours against each kiddo release's own query, per k (same run, interleaved passes).
+    let rate = |name: &str, k: usize| {
+        rows.iter()
+            .find(|r| r.name == name && r.k == k)
+            .map(|r| r.queries_per_s)
+    };
+    for k in [50, 250, 1000] {
+        if let (Some(ours), Some(k5), Some(k6)) = (
+            rate("kd_tree", k),
+            rate("kiddo_raw", k),
+            rate("kiddo6_raw", k),
+        ) {
+            println!(
+                "k = {k:4}: kd_tree {:.2}x kiddo 5, {:.2}x kiddo 6",
+                ours / k5,
+                ours / k6
+            );
+        }
     }
     let res = 128;
     println!(
