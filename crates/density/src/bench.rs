@@ -17,7 +17,8 @@ const RUNS: usize = 3;
 #[derive(Clone, Copy, Debug)]
 pub struct KnnBench {
     pub index: IndexKind,
-    /// The index's name, or "kiddo_raw": kiddo 5's own `nearest_n` (sorted by distance, no
+    /// The index's name; "kd_map": our kd-tree relabelled by slot, as `PhotonMap` holds it;
+    /// or "kiddo_raw": kiddo 5's own `nearest_n` (sorted by distance, no
     /// tie rule), the fairest figure for kiddo; "kiddo6_raw": the same query in kiddo 6,
     /// its newest release (the stable build: its SIMD paths need a nightly compiler).
     pub name: &'static str,
@@ -63,12 +64,33 @@ pub fn bench_knn(photons: usize, ks: &[usize], queries: usize, seed: u64) -> Vec
     let t0 = Instant::now();
     let kiddo6 = kiddo6::ImmutableKdTree::<f32, 3>::new_from_slice(&points);
     let kiddo6 = kiddo6.map(|t| (t, t0.elapsed().as_secs_f64()));
+    // The kd-tree as `PhotonMap` holds it: photons reordered to its slot order at build,
+    // so results are slots and no id is looked up (kiddo keeps its items in its leaves).
+    let map = built.iter().find_map(|(i, t)| match i {
+        Index::KdTree(tree) => {
+            let mut tree = tree.clone();
+            tree.relabel_by_slot();
+            Some((Index::KdTree(tree), *t))
+        }
+        _ => None,
+    });
     let mut runs: Vec<Run> = built.iter().map(|(i, t)| Run::Index(i, *t)).collect();
-    if let Some((ki, t)) = built.iter().find(|(i, _)| i.kind() == IndexKind::Kiddo) {
-        runs.insert(2, Run::KiddoRaw(ki, *t));
+    let kd_at = runs
+        .iter()
+        .position(|r| matches!(r, Run::Index(Index::KdTree(_), _)));
+    if let (Some(at), Some((i, t))) = (kd_at, &map) {
+        runs.insert(at + 1, Run::Map(i, *t));
     }
-    if let Ok((tree, t)) = &kiddo6 {
-        runs.insert(3, Run::Kiddo6Raw(tree, *t));
+    let kiddo_at = runs.iter().position(|r| r.kind() == IndexKind::Kiddo);
+    // kiddo's own queries right after ours through its index.
+    if let (Some(at), Some((ki, t))) = (
+        kiddo_at,
+        built.iter().find(|(i, _)| i.kind() == IndexKind::Kiddo),
+    ) {
+        runs.insert(at + 1, Run::KiddoRaw(ki, *t));
+        if let Ok((tree, t)) = &kiddo6 {
+            runs.insert(at + 2, Run::Kiddo6Raw(tree, *t));
+        }
     }
     let mut out = Vec::new();
     for &k in ks {
@@ -88,7 +110,7 @@ pub fn bench_knn(photons: usize, ks: &[usize], queries: usize, seed: u64) -> Vec
                             .nearest_n::<kiddo6::SquaredEuclidean<f32>>(k1)
                             .execute()
                             .len(),
-                        Run::Index(index, _) | Run::KiddoRaw(index, _) => {
+                        Run::Index(index, _) | Run::Map(index, _) | Run::KiddoRaw(index, _) => {
                             index.knn(q, k, f32::INFINITY, &mut scratch);
                             scratch.len()
                         }
@@ -103,6 +125,7 @@ pub fn bench_knn(photons: usize, ks: &[usize], queries: usize, seed: u64) -> Vec
             let nq = queries_for(run.kind(), photons, qs.len());
             let (name, build_s) = match run {
                 Run::Index(i, b) => (i.kind().name(), *b),
+                Run::Map(_, b) => ("kd_map", *b),
                 Run::KiddoRaw(_, b) => ("kiddo_raw", *b),
                 Run::Kiddo6Raw(_, b) => ("kiddo6_raw", *b),
             };
@@ -123,6 +146,8 @@ pub fn bench_knn(photons: usize, ks: &[usize], queries: usize, seed: u64) -> Vec
 /// One timed contender: an index through our `knn`, or kiddo 5's or 6's own `nearest_n`.
 enum Run<'a> {
     Index(&'a Index, f64),
+    /// Our kd-tree relabelled by slot, as the photon map uses it.
+    Map(&'a Index, f64),
     KiddoRaw(&'a Index, f64),
     Kiddo6Raw(&'a kiddo6::ImmutableKdTree<f32, 3>, f64),
 }
@@ -130,7 +155,7 @@ enum Run<'a> {
 impl Run<'_> {
     fn kind(&self) -> IndexKind {
         match self {
-            Run::Index(i, _) | Run::KiddoRaw(i, _) => i.kind(),
+            Run::Index(i, _) | Run::Map(i, _) | Run::KiddoRaw(i, _) => i.kind(),
             Run::Kiddo6Raw(..) => IndexKind::Kiddo,
         }
     }

@@ -484,16 +484,16 @@ pub fn knn(photons: usize, queries: usize) -> Result<(), String> {
             .map(|r| r.queries_per_s)
     };
     for k in [50, 250, 1000] {
-        if let (Some(ours), Some(k5), Some(k6)) = (
-            rate("kd_tree", k),
-            rate("kiddo_raw", k),
-            rate("kiddo6_raw", k),
-        ) {
-            println!(
-                "k = {k:4}: kd_tree {:.2}x kiddo 5, {:.2}x kiddo 6",
-                ours / k5,
-                ours / k6
-            );
+        for ours in ["kd_map", "kd_tree"] {
+            if let (Some(o), Some(k5), Some(k6)) =
+                (rate(ours, k), rate("kiddo_raw", k), rate("kiddo6_raw", k))
+            {
+                println!(
+                    "k = {k:4}: {ours:>7} {:.2}x kiddo 5, {:.2}x kiddo 6",
+                    o / k5,
+                    o / k6
+                );
+            }
         }
     }
     let res = 128;
