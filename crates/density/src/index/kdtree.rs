@@ -284,7 +284,7 @@ impl KdTree {
         }
     }
 
-    /// Fixed-radius search: every point with `d2 <= r2` as `(slot, d2)`, in slot order (an
+    /// Fixed-radius search: every point with `d2 <= r2` as `(index, d2)`, in slot order (an
     /// in-order walk of the leaves), so the output order depends on the set alone. Gives up
     /// (returns false, `out` partial) once more than `cap` are in. `out`'s old entries are
     /// overwritten, not cleared first: its length is room to write into without
@@ -340,12 +340,21 @@ impl KdTree {
             // never changes it; it lets the compiler drop the bounds check.
             let dst = &mut out[len..len + LEAF];
             let mut kept = 0;
-            for (j, &d2) in d2s[..m].iter().enumerate() {
-                dst[kept & (LEAF - 1)] = Neighbor {
-                    index: (lo + j) as u32,
-                    d2,
-                };
-                kept += (d2 <= r2) as usize;
+            if self.identity {
+                for (j, &d2) in d2s[..m].iter().enumerate() {
+                    dst[kept & (LEAF - 1)] = Neighbor {
+                        index: (lo + j) as u32,
+                        d2,
+                    };
+                    kept += (d2 <= r2) as usize;
+                }
+            } else {
+                // Ids read here, beside the leaf's positions, so their cache misses overlap
+                // those rather than wait in a later pass (16% of a k = 50 query).
+                for (&index, &d2) in self.ids[lo..hi].iter().zip(&d2s[..m]) {
+                    dst[kept & (LEAF - 1)] = Neighbor { index, d2 };
+                    kept += (d2 <= r2) as usize;
+                }
             }
             len += kept;
             if len > cap {
@@ -355,15 +364,6 @@ impl KdTree {
         }
         out.truncate(len);
         true
-    }
-
-    /// Slots in `out` to indices (a no-op after [`KdTree::relabel_by_slot`]).
-    fn slots_to_indices(&self, out: &mut [Neighbor]) {
-        if !self.identity {
-            for n in out.iter_mut() {
-                n.index = self.ids[n.index as usize];
-            }
-        }
     }
 
     /// The same neighbours as [`KdTree::knn`], but in slot order (a fixed permutation of
@@ -434,8 +434,6 @@ impl KdTree {
             };
             self.gather(qa, r2, usize::MAX, out);
         }
-        // Slots to indices before selecting: ties break by index.
-        self.slots_to_indices(out);
     }
 
     /// Every point with `d2 <= r^2`, sorted by `(d2, index)` (see [`super::Index::within`]).
@@ -449,7 +447,6 @@ impl KdTree {
     pub(crate) fn within_in_index_order(&self, q: Vec3, r: f32, out: &mut Vec<Neighbor>) {
         self.gather(q.to_array(), radius2(r), usize::MAX, out);
         if !self.identity {
-            self.slots_to_indices(out);
             out.sort_unstable_by_key(|n| n.index);
         }
     }
