@@ -12,7 +12,7 @@ use std::hint::black_box;
 use std::num::NonZero;
 use std::time::Instant;
 
-const RUNS: usize = 3;
+const RUNS: usize = 5;
 
 #[derive(Clone, Copy, Debug)]
 pub struct KnnBench {
