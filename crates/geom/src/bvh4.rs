@@ -1,8 +1,8 @@
 //! The default acceleration structure: a 4-wide BVH with full-precision f32 child boxes in
 //! structure-of-arrays layout (one SSE compare tests all four children), collapsed from an
 //! obvhs `Bvh2` (PLOC + reinsertion) by the collapse that minimises the surface area
-//! heuristic (dynamic programming, `Builder::optimize`). Triangles *and* spheres are its primitives, so a ray
-//! pays for a sphere only when it enters the sphere's box.
+//! heuristic (dynamic programming, `Builder::optimize`). Triangles *and* spheres are its
+//! primitives, so a ray pays for a sphere only when it enters the sphere's box.
 //!
 //! Leaves hold up to `LEAF_MAX` triangles in blocks of four, tested together with the
 //! watertight test of Woop, Benthin and Wald (JCGT 2013), or one sphere.
@@ -477,14 +477,12 @@ impl Bvh4 {
     }
 }
 
-/// Relative costs of the collapse's surface area heuristic: visiting a node (one 4-wide box
-/// test) and testing one leaf block (four triangles) or a sphere, per unit of area.
 /// Relative costs of the collapse's surface area heuristic, per unit of area: visiting a node
 /// (one 4-wide box test), testing a leaf block (four triangles) or a sphere. A block costing
 /// 1, 2 or 3 node visits measured the same in `bench-rays` (pinned, 5 alternating rounds).
-const COST_NODE: f32 = 1.0;
-const COST_BLOCK: f32 = 1.0;
-const COST_SPHERE: f32 = 1.0;
+const COST_NODE: f64 = 1.0;
+const COST_BLOCK: f64 = 1.0;
+const COST_SPHERE: f64 = 1.0;
 
 /// What the collapse decided for one Bvh2 node and a number of slots.
 #[derive(Clone, Copy, Default)]
@@ -508,7 +506,7 @@ struct Builder<'a> {
     mesh: &'a TriMesh,
     /// Per Bvh2 node and slot count `i` (index `i - 1`): least SAH cost of the subtree as a
     /// forest of at most `i` subtrees, and the choice that reaches it.
-    cost: Vec<[f32; 4]>,
+    cost: Vec<[f64; 4]>,
     choice: Vec<[Choice; 4]>,
     out: Bvh4,
 }
@@ -526,7 +524,7 @@ impl Builder<'_> {
     /// sphere.
     fn optimize(&mut self, ni: usize) -> (u32, bool) {
         let node = self.bvh2.nodes[ni];
-        let area = node.aabb().half_area();
+        let area = node.aabb().half_area() as f64;
         let Some((l, r)) = self.children(ni) else {
             let p = self.bvh2.primitive_indices[node.first_index as usize];
             let is_sphere = p >= self.n_tri;
@@ -549,7 +547,7 @@ impl Builder<'_> {
         let (inner, k) = split(4);
         let mut best = (area * COST_NODE + inner, Choice::Node(k));
         if !sphere && count <= LEAF_MAX {
-            let leaf = area * COST_BLOCK * count.div_ceil(4) as f32;
+            let leaf = area * COST_BLOCK * count.div_ceil(4) as f64;
             if leaf <= best.0 {
                 best = (leaf, Choice::Leaf);
             }
@@ -713,13 +711,13 @@ mod tests {
                 cost += if c & LEAF == 0 {
                     node(b, c)
                 } else if c & SPHERE != 0 {
-                    half_area(clo, chi) * COST_SPHERE as f64
+                    half_area(clo, chi) * COST_SPHERE
                 } else {
                     let blocks = (c & !LEAF) >> COUNT_SHIFT;
-                    half_area(clo, chi) * (COST_BLOCK * blocks as f32) as f64
+                    half_area(clo, chi) * COST_BLOCK * blocks as f64
                 };
             }
-            cost + half_area(lo, hi) * COST_NODE as f64
+            cost + half_area(lo, hi) * COST_NODE
         }
         node(b, b.root)
     }
@@ -753,10 +751,8 @@ mod tests {
         }
         fn leaf_cost(&self, ni: usize) -> Option<f64> {
             match self.count(ni) {
-                (0, 1) => Some(self.area(ni) * COST_SPHERE as f64),
-                (t, 0) if t <= LEAF_MAX => {
-                    Some(self.area(ni) * (COST_BLOCK * t.div_ceil(4) as f32) as f64)
-                }
+                (0, 1) => Some(self.area(ni) * COST_SPHERE),
+                (t, 0) if t <= LEAF_MAX => Some(self.area(ni) * COST_BLOCK * t.div_ceil(4) as f64),
                 _ => None,
             }
         }
@@ -768,7 +764,7 @@ mod tests {
                 for k in 1..4 {
                     for a in self.all_forests(l, k) {
                         for b in self.all_forests(r, 4 - k) {
-                            out.push(self.area(ni) * COST_NODE as f64 + a + b);
+                            out.push(self.area(ni) * COST_NODE + a + b);
                         }
                     }
                 }
@@ -806,7 +802,7 @@ mod tests {
                 kids[i] = a;
                 kids.push(b);
             }
-            self.area(ni) * COST_NODE as f64 + kids.iter().map(|&k| self.greedy(k)).sum::<f64>()
+            self.area(ni) * COST_NODE + kids.iter().map(|&k| self.greedy(k)).sum::<f64>()
         }
     }
 
