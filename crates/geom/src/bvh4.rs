@@ -243,28 +243,7 @@ impl Bvh4 {
         params: BvhBuildParams,
     ) -> Option<Bvh4> {
         let n_tri = mesh.len();
-        let mut aabbs: Vec<Aabb> = (0..n_tri)
-            .map(|i| {
-                let [a, b, c] = mesh.vertices(i);
-                Aabb::new(a.min(b).min(c).into(), a.max(b).max(c).into())
-            })
-            .collect();
-        // The f32 box of a sphere, widened by an ulp so it contains the exact sphere.
-        aabbs.extend(spheres.iter().map(|s| {
-            let lo = (s.center - s.radius).to_array().map(next_down);
-            let hi = (s.center + s.radius).to_array().map(next_up);
-            Aabb::new(glam::Vec3A::from_array(lo), glam::Vec3A::from_array(hi))
-        }));
-        if aabbs.is_empty() {
-            return None;
-        }
-        // One primitive per Bvh2 leaf: the collapse below forms the leaves, and keeps
-        // spheres out of triangle blocks.
-        let params = BvhBuildParams {
-            max_prims_per_leaf: 1,
-            ..params
-        };
-        let bvh2 = build_bvh2(&aabbs, params, &mut Duration::default());
+        let bvh2 = binary_bvh(mesh, spheres, params)?;
         let mut b = Builder {
             bvh2: &bvh2,
             n_tri: n_tri as u32,
@@ -497,6 +476,32 @@ enum Choice {
     Split(u8),
     /// `i` slots: no better than `i - 1` slots.
     Fewer,
+}
+
+/// The obvhs `Bvh2` the collapse starts from: triangles, then spheres, one primitive per
+/// leaf (the collapse forms the leaves, and keeps spheres out of triangle blocks). `None`
+/// when there is nothing to index.
+fn binary_bvh(mesh: &TriMesh, spheres: &[Sphere], params: BvhBuildParams) -> Option<Bvh2> {
+    let mut aabbs: Vec<Aabb> = (0..mesh.len())
+        .map(|i| {
+            let [a, b, c] = mesh.vertices(i);
+            Aabb::new(a.min(b).min(c).into(), a.max(b).max(c).into())
+        })
+        .collect();
+    // The f32 box of a sphere, widened by an ulp so it contains the exact sphere.
+    aabbs.extend(spheres.iter().map(|s| {
+        let lo = (s.center - s.radius).to_array().map(next_down);
+        let hi = (s.center + s.radius).to_array().map(next_up);
+        Aabb::new(glam::Vec3A::from_array(lo), glam::Vec3A::from_array(hi))
+    }));
+    if aabbs.is_empty() {
+        return None;
+    }
+    let params = BvhBuildParams {
+        max_prims_per_leaf: 1,
+        ..params
+    };
+    Some(build_bvh2(&aabbs, params, &mut Duration::default()))
 }
 
 struct Builder<'a> {
@@ -810,22 +815,7 @@ mod tests {
         let params = BvhBuildParams::medium_build();
         let b = Bvh4::build(mesh, spheres, params).expect("non-empty");
         // The same deterministic Bvh2 the collapse started from.
-        let mut aabbs: Vec<Aabb> = (0..mesh.len())
-            .map(|i| {
-                let [a, b, c] = mesh.vertices(i);
-                Aabb::new(a.min(b).min(c).into(), a.max(b).max(c).into())
-            })
-            .collect();
-        aabbs.extend(spheres.iter().map(|s| {
-            let lo = (s.center - s.radius).to_array().map(next_down);
-            let hi = (s.center + s.radius).to_array().map(next_up);
-            Aabb::new(glam::Vec3A::from_array(lo), glam::Vec3A::from_array(hi))
-        }));
-        let params = BvhBuildParams {
-            max_prims_per_leaf: 1,
-            ..params
-        };
-        (b, build_bvh2(&aabbs, params, &mut Duration::default()))
+        (b, binary_bvh(mesh, spheres, params).expect("non-empty"))
     }
 
     #[test]
