@@ -607,3 +607,37 @@ fn rays_through_shared_edges_and_vertices_of_a_closed_mesh_never_slip_through() 
     }
     assert!(cast > 50_000);
 }
+
+/// pbrt-v4 §6.8.7: the triangle test reports a hit only when its `t` is conservatively above
+/// zero. Rays start on the triangle itself (a barycentric point, rounded to f32, so a hair in
+/// front of or behind the plane) without the spawn offset, the case the bound exists for:
+/// every hit reported must lie in front of the origin by the exact (f64) plane distance.
+#[test]
+fn triangle_hits_from_the_surface_itself_are_never_behind_the_origin() {
+    let mut rng = Rng::new(21);
+    for _ in 0..2_000 {
+        let scale = 10f32.powi(rng.below(7) as i32 - 3);
+        let p = [0; 3].map(|_| rand_vec(&mut rng, -scale, scale) + Vec3::splat(3.0 * scale));
+        let geo = Geometry::new(mesh_of(&[(p.to_vec(), vec![[0, 1, 2]])]), vec![]);
+        let pd = p.map(|v| v.as_dvec3());
+        let n = (pd[1] - pd[0]).cross(pd[2] - pd[0]);
+        for _ in 0..50 {
+            let (b1, b2) = (rng.uniform(), rng.uniform());
+            let (b1, b2) = if b1 + b2 > 1.0 {
+                (1.0 - b1, 1.0 - b2)
+            } else {
+                (b1, b2)
+            };
+            let o = (1.0 - b1 - b2) * p[0] + b1 * p[1] + b2 * p[2];
+            // Mostly grazing directions: the computed t is then far from exact.
+            let d = (rand_dir(&mut rng) + 30.0 * (p[1] - p[0]).normalize()).normalize();
+            // Measured: 12 of the 100 000 rays hit (from a hair behind the plane), all in
+            // front; without the bound this fails on a hit behind the origin.
+            if let Some((t, _)) = geo.closest(&Ray::new(o, d)) {
+                let od = o.as_dvec3();
+                let t_exact = n.dot(pd[0] - od) / n.dot(d.as_dvec3());
+                assert!(t_exact > 0.0, "hit at t {t} but the plane is at {t_exact}");
+            }
+        }
+    }
+}
