@@ -5,7 +5,7 @@
 //! Queries are fresh points on the same faces (with their own seed). Single-threaded; each
 //! figure is the median of `RUNS` passes over the same queries.
 
-use crate::index::{Index, IndexKind, Neighbor};
+use crate::index::{Index, IndexKind, Kiddo, Neighbor};
 use glam::Vec3;
 use math::Rng;
 use std::hint::black_box;
@@ -83,11 +83,12 @@ pub fn bench_knn(photons: usize, ks: &[usize], queries: usize, seed: u64) -> Vec
     }
     let kiddo_at = runs.iter().position(|r| r.kind() == IndexKind::Kiddo);
     // kiddo's own queries right after ours through its index.
-    if let (Some(at), Some((ki, t))) = (
-        kiddo_at,
-        built.iter().find(|(i, _)| i.kind() == IndexKind::Kiddo),
-    ) {
-        runs.insert(at + 1, Run::KiddoRaw(ki, *t));
+    let kiddo = built.iter().find_map(|(i, t)| match i {
+        Index::Kiddo(kd) => Some((kd, *t)),
+        _ => None,
+    });
+    if let (Some(at), Some((kd, t))) = (kiddo_at, kiddo) {
+        runs.insert(at + 1, Run::KiddoRaw(kd, t));
         if let Ok((tree, t)) = &kiddo6 {
             runs.insert(at + 2, Run::Kiddo6Raw(tree, *t));
         }
@@ -104,13 +105,13 @@ pub fn bench_knn(photons: usize, ks: &[usize], queries: usize, seed: u64) -> Vec
                 let mut acc = 0usize;
                 for &q in &qs[..nq] {
                     acc += match run {
-                        Run::KiddoRaw(Index::Kiddo(kd), _) => kd.nearest_n_raw(q, k),
+                        Run::KiddoRaw(kd, _) => kd.nearest_n_raw(q, k),
                         Run::Kiddo6Raw(tree, _) => tree
                             .query(&q.to_array())
                             .nearest_n::<kiddo6::SquaredEuclidean<f32>>(k1)
                             .execute()
                             .len(),
-                        Run::Index(index, _) | Run::Map(index, _) | Run::KiddoRaw(index, _) => {
+                        Run::Index(index, _) | Run::Map(index, _) => {
                             index.knn(q, k, f32::INFINITY, &mut scratch);
                             scratch.len()
                         }
@@ -148,15 +149,15 @@ enum Run<'a> {
     Index(&'a Index, f64),
     /// Our kd-tree relabelled by slot, as the photon map uses it.
     Map(&'a Index, f64),
-    KiddoRaw(&'a Index, f64),
+    KiddoRaw(&'a Kiddo, f64),
     Kiddo6Raw(&'a kiddo6::ImmutableKdTree<f32, 3>, f64),
 }
 
 impl Run<'_> {
     fn kind(&self) -> IndexKind {
         match self {
-            Run::Index(i, _) | Run::Map(i, _) | Run::KiddoRaw(i, _) => i.kind(),
-            Run::Kiddo6Raw(..) => IndexKind::Kiddo,
+            Run::Index(i, _) | Run::Map(i, _) => i.kind(),
+            Run::KiddoRaw(..) | Run::Kiddo6Raw(..) => IndexKind::Kiddo,
         }
     }
 }

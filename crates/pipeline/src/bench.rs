@@ -157,10 +157,15 @@ fn peer_ratios(
 
 /// `Cpus_allowed_list` from `/proc/self/status` (Linux), e.g. `0-1` or `1`.
 fn allowed_cpus() -> Option<String> {
+    proc_status("Cpus_allowed_list")
+}
+
+/// The value of `key` in `/proc/self/status` (Linux only; `None` elsewhere).
+fn proc_status(key: &str) -> Option<String> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     status
         .lines()
-        .find_map(|l| l.strip_prefix("Cpus_allowed_list:"))
+        .find_map(|l| l.strip_prefix(key)?.strip_prefix(':'))
         .map(|v| v.trim().to_string())
 }
 
@@ -517,9 +522,11 @@ pub fn knn(photons: usize, queries: usize) -> Result<(), String> {
 
 /// Peak resident memory of this process so far (Linux `VmHWM`), in MiB; `None` elsewhere.
 fn peak_rss_mib() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    let kb: f64 = proc_status("VmHWM")?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()?;
     Some(kb / 1024.0)
 }
 
