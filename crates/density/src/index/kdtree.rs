@@ -2,7 +2,9 @@
 //! leaf's density or a hint; depth-first with buffered selection as the fallback), and a
 //! fixed-radius range search.
 
-use super::{Best, KnnHint, Neighbor, Points, dist2, keep_k_smallest, radius2, sort_neighbors};
+use super::{
+    Best, KnnHint, Neighbor, Points, dist2, keep_k_smallest, prefetch, radius2, sort_neighbors,
+};
 use glam::Vec3;
 
 /// Our kd-tree, a bucket tree built in place (Friedman, Bentley, Finkel 1977, "An
@@ -38,6 +40,9 @@ pub struct KdTree {
 /// Most points per leaf: 32, kiddo's bucket size too (not yet tuned for this tree; the
 /// in-place tree it replaced had measured 16 best).
 const LEAF: usize = 32;
+
+/// Leaves a range search finds (and prefetches) before it reads them.
+const BATCH: usize = 16;
 
 /// The depth at which every leaf holds at most `LEAF` of `n` points (sizes at one depth
 /// differ by at most one, the largest being ceil(n / 2^depth)).
@@ -296,6 +301,9 @@ impl KdTree {
         }
         let nodes = self.split.len();
         let mut len = 0;
+        // Leaves in reach, found ahead of reading them (see `prefetch_leaf`).
+        let mut pending = [(0u32, 0u32); BATCH];
+        let mut np = 0;
         // (node, lo, hi, per-axis distance from q to the node's cell). Depth <= 32, one
         // entry left behind per level.
         let mut stack = [(0u32, 0u32, 0u32, [0f32; 3]); 40];
@@ -331,39 +339,62 @@ impl KdTree {
                     (None, r) => (node, lo, off) = (2 * node + 2, mid, r.unwrap_or(off)),
                 }
             }
-            let m = hi - lo;
-            let d2s = leaf_d2(&self.pts, lo, hi, q);
-            if out.len() < len + LEAF {
-                out.resize(2 * out.len() + LEAF, Neighbor { index: 0, d2: 0.0 });
+            self.prefetch_leaf(lo, hi);
+            pending[np] = (lo as u32, hi as u32);
+            np += 1;
+            if np < BATCH && sp > 0 {
+                continue;
             }
-            // Branch-free left-pack (as in `search`). `kept <= j < LEAF`, so the mask
-            // never changes it; it lets the compiler drop the bounds check.
-            let dst = &mut out[len..len + LEAF];
-            let mut kept = 0;
-            if self.identity {
-                for (j, &d2) in d2s[..m].iter().enumerate() {
-                    dst[kept & (LEAF - 1)] = Neighbor {
-                        index: (lo + j) as u32,
-                        d2,
-                    };
-                    kept += (d2 <= r2) as usize;
+            for &(lo, hi) in &pending[..np] {
+                let (lo, hi) = (lo as usize, hi as usize);
+                let m = hi - lo;
+                let d2s = leaf_d2(&self.pts, lo, hi, q);
+                if out.len() < len + LEAF {
+                    out.resize(2 * out.len() + LEAF, Neighbor { index: 0, d2: 0.0 });
                 }
-            } else {
-                // Ids read here, beside the leaf's positions, so their cache misses overlap
-                // those rather than wait in a later pass (16% of a k = 50 query).
-                for (&index, &d2) in self.ids[lo..hi].iter().zip(&d2s[..m]) {
-                    dst[kept & (LEAF - 1)] = Neighbor { index, d2 };
-                    kept += (d2 <= r2) as usize;
+                // Branch-free left-pack (as in `search`). `kept <= j < LEAF`, so the mask
+                // never changes it; it lets the compiler drop the bounds check.
+                let dst = &mut out[len..len + LEAF];
+                let mut kept = 0;
+                if self.identity {
+                    for (j, &d2) in d2s[..m].iter().enumerate() {
+                        dst[kept & (LEAF - 1)] = Neighbor {
+                            index: (lo + j) as u32,
+                            d2,
+                        };
+                        kept += (d2 <= r2) as usize;
+                    }
+                } else {
+                    // Ids read here, beside the leaf's positions, so their cache misses
+                    // overlap those rather than wait in a later pass.
+                    for (&index, &d2) in self.ids[lo..hi].iter().zip(&d2s[..m]) {
+                        dst[kept & (LEAF - 1)] = Neighbor { index, d2 };
+                        kept += (d2 <= r2) as usize;
+                    }
+                }
+                len += kept;
+                if len > cap {
+                    out.truncate(len);
+                    return false;
                 }
             }
-            len += kept;
-            if len > cap {
-                out.truncate(len);
-                return false;
-            }
+            np = 0;
         }
         out.truncate(len);
         true
+    }
+
+    /// Ask for a leaf's positions (and ids) ahead of reading them: a range search finds its
+    /// leaves from the splits alone (in cache), so the leaves' misses, each at a random spot
+    /// in megabytes of points, are in flight together instead of one leaf after another.
+    #[inline(always)]
+    fn prefetch_leaf(&self, lo: usize, hi: usize) {
+        for row in &self.pts.xyz {
+            prefetch(&row[lo..hi]);
+        }
+        if !self.identity {
+            prefetch(&self.ids[lo..hi]);
+        }
     }
 
     /// The same neighbours as [`KdTree::knn`], but in slot order (a fixed permutation of

@@ -257,6 +257,40 @@ fn sort_bucketed<const B: usize>(out: &mut Vec<Neighbor>, k: usize) {
     }
 }
 
+/// Ask the cache for every line of `s` ahead of reading it: `prefetcht0` on x86_64,
+/// nothing elsewhere. Only the kd-tree's range search uses it (see
+/// `KdTree::prefetch_leaf`), so the crate's one `unsafe` is this hint.
+#[inline(always)]
+pub(crate) fn prefetch<T>(s: &[T]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use core::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let bytes = std::mem::size_of_val(s);
+        let p = s.as_ptr().cast::<i8>();
+        // One address per 64-byte line from the first byte, and the last byte.
+        let last = bytes.saturating_sub(1);
+        let mut off = 0;
+        while off < bytes {
+            // SAFETY: a prefetch is a hint: it never faults and changes no memory (Intel SDM,
+            // PREFETCHh); the addresses lie inside `s` anyway.
+            #[allow(unsafe_code)]
+            unsafe {
+                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(off.min(last)))
+            };
+            off += 64;
+        }
+        if bytes > 0 {
+            #[allow(unsafe_code)]
+            // SAFETY: as above.
+            unsafe {
+                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(last))
+            };
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = s;
+}
+
 /// `v` rounded to an integer, for 0 <= v <= 2^22, without a float-to-integer conversion:
 /// v + 2^23 has exponent 23, so its low mantissa bits are v rounded (the usual "magic
 /// number" trick). Monotone like the floor, which is all bucketing needs.
