@@ -258,8 +258,7 @@ fn sort_bucketed<const B: usize>(out: &mut Vec<Neighbor>, k: usize) {
 }
 
 /// Ask the cache for every line of `s` ahead of reading it: `prefetcht0` on x86_64,
-/// nothing elsewhere. Only the kd-tree's range search uses it (see
-/// `KdTree::prefetch_leaf`), so the crate's one `unsafe` is this hint.
+/// nothing elsewhere. The crate's only `unsafe` code (for `KdTree::prefetch_leaf`).
 #[inline(always)]
 pub(crate) fn prefetch<T>(s: &[T]) {
     #[cfg(target_arch = "x86_64")]
@@ -267,23 +266,15 @@ pub(crate) fn prefetch<T>(s: &[T]) {
         use core::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
         let bytes = std::mem::size_of_val(s);
         let p = s.as_ptr().cast::<i8>();
-        // One address per 64-byte line from the first byte, and the last byte.
-        let last = bytes.saturating_sub(1);
-        let mut off = 0;
-        while off < bytes {
-            // SAFETY: a prefetch is a hint: it never faults and changes no memory (Intel SDM,
-            // PREFETCHh); the addresses lie inside `s` anyway.
+        // One address in each 64-byte line `s` touches: every 64th byte from the first,
+        // then the last (the first's line need not start at `s`).
+        let offs = (0..bytes).step_by(64).chain(bytes.checked_sub(1));
+        for off in offs {
+            // SAFETY: a prefetch is a hint: it never faults and changes no memory (Intel
+            // SDM, PREFETCHh), and every address lies inside `s` anyway.
             #[allow(unsafe_code)]
             unsafe {
-                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(off.min(last)))
-            };
-            off += 64;
-        }
-        if bytes > 0 {
-            #[allow(unsafe_code)]
-            // SAFETY: as above.
-            unsafe {
-                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(last))
+                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(off))
             };
         }
     }
