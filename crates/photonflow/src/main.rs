@@ -12,6 +12,18 @@ fn main() -> ExitCode {
         eprintln!("interrupted: removed {n} unfinished photon file(s)");
         std::process::exit(130);
     });
+    // Rust ignores SIGPIPE, so once a reader closes our stdout (`photonflow ... | head`) every
+    // `println!` panics. End as a C tool killed by SIGPIPE would instead: no message, the
+    // status a shell reports for it (128 + 13), and no unfinished photon file left behind.
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let msg = info.payload_as_str().unwrap_or("");
+        if msg.starts_with("failed printing to stdout") && msg.contains("Broken pipe") {
+            store::remove_live_temp_files();
+            std::process::exit(141);
+        }
+        default_hook(info);
+    }));
     let (code, error) = photonflow::run_args(std::env::args_os());
     if let Some(e) = error {
         eprintln!("{e}");

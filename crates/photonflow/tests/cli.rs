@@ -82,6 +82,27 @@ fn a_good_scene_exits_zero() {
 }
 
 #[test]
+fn a_closed_stdout_ends_quietly_with_the_sigpipe_status() {
+    let dir = Scratch::new(
+        "pipe",
+        &[("s.toml", &toml()), ("a.obj", OBJ), ("m.mtl", MTL)],
+    );
+    // A pipe whose reader is gone before the child starts: its first write fails.
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = Command::new(env!("CARGO_BIN_EXE_photonflow"))
+        .arg("info")
+        .arg(dir.0.join("s.toml"))
+        .stdout(writer)
+        .stderr(std::process::Stdio::piped())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(141), "{stderr}");
+    assert!(stderr.is_empty(), "{stderr}");
+}
+
+#[test]
 fn bad_inputs_fail_cleanly() {
     let t = toml();
     check("missing-scene", &[], "s.toml", "cannot read scene file");
