@@ -206,7 +206,7 @@ impl KdTree {
         let qa = q.to_array();
         let guess = self.leaf_guess2(qa, k);
         self.radius_first(qa, k, radius2(r_max), guess, out);
-        // Sorting every candidate (about 1.5 k) and keeping the first k costs less than
+        // Sorting every candidate (about 1.3 k, see `leaf_guess2`) and keeping the first k costs less than
         // selecting k first and sorting those.
         sort_neighbors(out, k);
     }
@@ -346,33 +346,7 @@ impl KdTree {
                 continue;
             }
             for &(lo, hi) in &pending[..np] {
-                let (lo, hi) = (lo as usize, hi as usize);
-                let m = hi - lo;
-                let d2s = leaf_d2(&self.pts, lo, hi, q);
-                if out.len() < len + LEAF {
-                    out.resize(2 * out.len() + LEAF, Neighbor { index: 0, d2: 0.0 });
-                }
-                // Branch-free left-pack (as in `search`). `kept <= j < LEAF`, so the mask
-                // never changes it; it lets the compiler drop the bounds check.
-                let dst = &mut out[len..len + LEAF];
-                let mut kept = 0;
-                if self.identity {
-                    for (j, &d2) in d2s[..m].iter().enumerate() {
-                        dst[kept & (LEAF - 1)] = Neighbor {
-                            index: (lo + j) as u32,
-                            d2,
-                        };
-                        kept += (d2 <= r2) as usize;
-                    }
-                } else {
-                    // Ids read here, beside the leaf's positions, so their cache misses
-                    // overlap those rather than wait in a later pass.
-                    for (&index, &d2) in self.ids[lo..hi].iter().zip(&d2s[..m]) {
-                        dst[kept & (LEAF - 1)] = Neighbor { index, d2 };
-                        kept += (d2 <= r2) as usize;
-                    }
-                }
-                len += kept;
+                len = self.pack_leaf(lo as usize, hi as usize, q, r2, len, out);
                 if len > cap {
                     out.truncate(len);
                     return false;
@@ -382,6 +356,47 @@ impl KdTree {
         }
         out.truncate(len);
         true
+    }
+
+    /// Append the points of leaf `[lo, hi)` with `d2 <= r2` to `out[..len]` as `(index, d2)`
+    /// in slot order; returns the new length. `out` only grows: entries past the returned
+    /// length are scratch.
+    #[inline(always)]
+    fn pack_leaf(
+        &self,
+        lo: usize,
+        hi: usize,
+        q: [f32; 3],
+        r2: f32,
+        len: usize,
+        out: &mut Vec<Neighbor>,
+    ) -> usize {
+        let d2s = leaf_d2(&self.pts, lo, hi, q);
+        let d2s = &d2s[..hi - lo];
+        if out.len() < len + LEAF {
+            out.resize(2 * out.len() + LEAF, Neighbor { index: 0, d2: 0.0 });
+        }
+        // Branch-free left-pack (as in `search`). `kept <= j < LEAF`, so the mask never
+        // changes it; it lets the compiler drop the bounds check.
+        let dst = &mut out[len..len + LEAF];
+        let mut kept = 0;
+        if self.identity {
+            for (j, &d2) in d2s.iter().enumerate() {
+                dst[kept & (LEAF - 1)] = Neighbor {
+                    index: (lo + j) as u32,
+                    d2,
+                };
+                kept += (d2 <= r2) as usize;
+            }
+        } else {
+            // Ids read here, beside the leaf's positions, so their cache misses overlap
+            // those rather than wait in a later pass.
+            for (&index, &d2) in self.ids[lo..hi].iter().zip(d2s) {
+                dst[kept & (LEAF - 1)] = Neighbor { index, d2 };
+                kept += (d2 <= r2) as usize;
+            }
+        }
+        len + kept
     }
 
     /// Ask for a leaf's positions (and ids) ahead of reading them: a range search finds its
