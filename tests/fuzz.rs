@@ -370,7 +370,7 @@ impl Corpus {
                 match scene::Scene::load(d.join("scene.toml")) {
                     Ok(s) => {
                         // The tables the pipeline reads from the scene file, parsed too.
-                        pipeline::Settings::new(&s, &pipeline::Overrides::default()).is_ok()
+                        render::Settings::new(&s, &render::Overrides::default()).is_ok()
                     }
                     Err(_) => false,
                 }

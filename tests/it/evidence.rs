@@ -2,8 +2,8 @@
 //! apart from independent runs against a long path-traced reference.
 
 use film::Image;
-use pipeline::Overrides;
-use pipeline::evidence::{Budget, Technique, regions, render_image, rung};
+use lab::evidence::{Budget, Technique, regions, render_image, rung};
+use render::Overrides;
 use scene::{Method, Scene};
 use std::path::{Path, PathBuf};
 use tests::{TempDir, scenes_dir};
@@ -39,7 +39,7 @@ fn bias_is_zero_for_the_path_tracer_and_grows_with_k_at_the_caustic() {
     let reference = reference(&cache);
     let scene = worksheet(1).unwrap();
     let regions = regions(&scene);
-    let region = |r: &pipeline::evidence::RungResult, name: &str| {
+    let region = |r: &lab::evidence::RungResult, name: &str| {
         r.region(name)
             .map(|x| (x.errors, x.sums))
             .unwrap_or_else(|| panic!("no region {name}"))
@@ -198,7 +198,7 @@ fn the_report_links_resolve_and_a_browser_shows_its_images() {
     let scene = dir.path().join("small.toml");
     std::fs::write(&scene, text).unwrap();
     let out = dir.path().join("evidence");
-    pipeline::evidence::run(&pipeline::evidence::EvidenceArgs {
+    lab::evidence(&lab::evidence::EvidenceArgs {
         scene,
         reference: None,
         reference_spp: 64,

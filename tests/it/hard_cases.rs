@@ -1,6 +1,6 @@
 //! Hard cases stay numerically stable (issue 12, point 5): one data-driven table ([`CASES`]),
 //! each case a scene built by a function, the methods it runs (through
-//! `pipeline::methods::render`, as the binary does) and a check. Every case checks that every
+//! `render::methods::render`, as the binary does) and a check. Every case checks that every
 //! pixel of every layer of every run is finite and non-negative and that the run made some
 //! light; the checks add what the scene allows:
 //!
@@ -24,7 +24,7 @@
 //! the case is deterministic (the numbers are in the comments and printed by the test).
 
 use glam::{DVec3, Vec3};
-use pipeline::{Overrides, Photons, Rendered, Run, Settings};
+use render::{Overrides, Photons, Rendered, Run, Settings};
 use scene::{Method, Scene, SceneFile};
 use std::cell::OnceCell;
 use std::fmt::Write as _;
@@ -357,7 +357,7 @@ fn render(scene: &Scene, o: &Overrides, cache: &Path) -> Rendered {
         photons: Photons::TraceOrReuse,
         threads: None,
     };
-    pipeline::methods::render(&run, &|_| {}).unwrap_or_else(|e| panic!("{e}"))
+    render::methods::render(&run, &|_| {}).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Every pixel of every layer finite and non-negative, and some light made.
@@ -1062,7 +1062,7 @@ fn check_focus(ctx: &Ctx) {
     assert!(photon_flux > 0.5 * all_flux, "{photon_flux} of {all_flux}");
     // Measured: +2.5% (the eye vertices' sampling of the focus, 16 per pixel, and splats
     // crossing the ball's silhouette). Before each spacing level of eye vertices read the
-    // photons through its own footprint (`pipeline::splat::EyeIndex`), -24%: a focused
+    // photons through its own footprint (`render::splat::EyeIndex`), -24%: a focused
     // photon's footprint was clamped to the spacing of its nearest vertex, often one seen
     // through the ball, and fell between the directly seen floor's vertices (16 passes:
     // -20%, so a bias, not noise).
@@ -1126,7 +1126,7 @@ fn point_photons(dir: &Path) -> Scene {
     );
     let scene = scene_file(dir, "point", camera, &body);
     let settings = Settings::new(&scene, &Overrides::default()).unwrap_or_else(|e| panic!("{e}"));
-    let key = pipeline::photon_cache::CacheKey::new(&scene, &settings.emit);
+    let key = photons::CacheKey::new(&scene, &settings.emit);
     let cache = dir.join("cache");
     std::fs::create_dir_all(&cache).unwrap_or_else(|e| panic!("{e}"));
     let mut w = store::StoreWriter::create(
@@ -1223,8 +1223,8 @@ fn check_point_photons(ctx: &Ctx) {
     // finite, at 1e-23 it underflows to 0 (zero again), at 0.1 it is the closed form.
     let (o, _) = &ctx.runs[0];
     let settings = Settings::new(ctx.scene, o).unwrap_or_else(|e| panic!("{e}"));
-    let key = pipeline::photon_cache::CacheKey::new(ctx.scene, &settings.emit);
-    let maps = pipeline::photon_cache::load_maps(&ctx.dir.join("cache"), &key, &[MapKind::Global]);
+    let key = photons::CacheKey::new(ctx.scene, &settings.emit);
+    let maps = render::maps::load(&ctx.dir.join("cache"), &key, &[MapKind::Global]);
     let maps = maps.unwrap_or_else(|e| panic!("{e}"));
     let map = maps[MapKind::Global]
         .as_ref()

@@ -1,5 +1,5 @@
 //! The photon-map methods end to end, in one process, through the functions the binary calls
-//! (`pipeline::trace`, `pipeline::methods::render`, `pipeline::maps::Maps::estimate`):
+//! (`render::trace`, `render::methods::render`, `render::maps::Maps::estimate`):
 //!
 //! - the furnace: photons traced into a cache directory, read back from the photon files,
 //!   estimated and shown by the eye pass, against `Le / (1 - rho)` with the k-NN bias
@@ -12,8 +12,8 @@
 use density::{EstimateParams, IndexKind, Kernel, KnnHint, PhotonMap};
 use geom::Prim;
 use glam::{DVec3, Vec3};
-use pipeline::maps::Maps;
-use pipeline::{Overrides, Photons, Rendered, Run, Settings};
+use render::maps::Maps;
+use render::{Overrides, Photons, Rendered, Run, Settings};
 use scene::{Material, Method, Scene};
 use std::path::Path;
 use store::{MapKind, PerKind};
@@ -30,7 +30,7 @@ fn render(scene: &Scene, o: &Overrides, cache: &Path) -> Rendered {
         photons: Photons::CacheOnly,
         threads: None,
     };
-    pipeline::methods::render(&run, &|_| {}).unwrap_or_else(|e| panic!("{e}"))
+    render::methods::render(&run, &|_| {}).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// The image: the sum of the layers whose names pass `keep`.
@@ -99,7 +99,7 @@ fn trace_furnace(scene: &Scene, cache: &Path) -> u64 {
         photons: Some(FURNACE_PATHS),
         ..Overrides::default()
     };
-    let t = pipeline::trace(scene, &o, cache, None, false).unwrap_or_else(|e| panic!("{e}"));
+    let t = render::trace(scene, &o, cache, None, false).unwrap_or_else(|e| panic!("{e}"));
     assert!(!t.reused, "a fresh cache directory cannot hold the sets");
     assert_eq!(
         t.files.len(),
@@ -725,7 +725,7 @@ fn compare_worksheet(seed: u64) -> Vec<Comparison> {
     // The scene's own [photons] and [estimate] tables: 200 000 paths; k = 1000 (global) and
     // 250 (caustic), uniform kernel; final gathering through the irradiance cache (every 4th
     // global photon) with 16 gather rays.
-    let t = pipeline::trace(&scene, &Overrides::default(), dir.path(), None, false)
+    let t = render::trace(&scene, &Overrides::default(), dir.path(), None, false)
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(t.files.len(), 2, "global and caustic sets");
     let with = |method, spp| Overrides {

@@ -4,7 +4,7 @@
 
 use bsdf::TransportMode;
 use emit::{EmitParams, Plan, chunks, trace_parallel, trace_range};
-use eye::{Part, PathOptions, PathTracer};
+use eye::{Class, PathOptions, PathTracer};
 use geom::{Hit, Prim, Ray};
 use glam::{DVec3, Vec2, Vec3};
 use math::warp::{sample_cosine_hemisphere, sample_uniform_disk_concentric};
@@ -129,7 +129,7 @@ fn albedo(scene: &Scene, material: u32) -> DVec3 {
 
 /// Path-tracer side: `Φ_PT = ∫_R E_c dA = A · mean E_c(x)` over `samples` uniform points x
 /// of R, with the caustic irradiance read from `eye`'s own estimate: a ray straight down
-/// onto x, whose `Part::Caustic` (`L S+ D E` with D = x) estimates the Lambertian floor's
+/// onto x, whose `Class::Caustic` (`L S+ D E` with D = x) estimates the Lambertian floor's
 /// outgoing caustic radiance `ρ/π E_c(x)`.
 fn eye_flux(scene: &Scene, samples: u64) -> (DVec3, DVec3) {
     let opts = PathOptions {
@@ -142,7 +142,7 @@ fn eye_flux(scene: &Scene, samples: u64) -> (DVec3, DVec3) {
     for i in 0..samples {
         let mut rng = Rng::for_index(scene.seed() ^ EYE_STREAM, i);
         let (ray, hit) = floor_point(scene, rng.uniform2());
-        let l = tracer.li(ray, &mut rng).get(Part::Caustic).as_dvec3();
+        let l = tracer.li(ray, &mut rng).get(Class::Caustic).as_dvec3();
         e.add(area * PI * l / albedo(scene, hit.material));
     }
     (e.mean(), e.se())

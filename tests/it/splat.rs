@@ -1,6 +1,6 @@
 //! Photon differential splatting end to end (issue 9), through the functions the binary calls
-//! (`pipeline::methods::render`) and the splatting stage's own pieces (`eye::eye_vertices`,
-//! `pipeline::splat::{EyeIndex, Splatter}`):
+//! (`render::methods::render`) and the splatting stage's own pieces (`eye::eye_vertices`,
+//! `render::splat::{EyeIndex, Splatter}`):
 //!
 //! 1. the splatted caustic under the glass sphere against the path tracer's caustic layer;
 //! 2. `path+splat` against `path`, region by region, and its layers' classes;
@@ -12,13 +12,14 @@
 
 use emit::{CausticPhoton, EmitParams, Plan};
 use eye::{EyeVertex, VertexOptions};
+use film::Class;
+use flow::PipelineOptions;
 use geom::Prim;
 use glam::{DVec3, Vec3};
-use pipeline::flow::PipelineOptions;
-use pipeline::methods::{CLASSES, CountKind};
-use pipeline::settings::SplatSettings;
-use pipeline::splat::{EyeIndex, Splatter};
-use pipeline::{Overrides, Photons, Rendered, Run, Settings};
+use render::methods::CountKind;
+use render::settings::SplatSettings;
+use render::splat::{EyeIndex, Splatter};
+use render::{Overrides, Photons, Rendered, Run, Settings};
 use scene::{Method, Scene};
 use std::path::Path;
 use std::sync::OnceLock;
@@ -55,7 +56,7 @@ fn render_in(scene: &Scene, o: &Overrides, threads: Option<usize>, cache: &Path)
         photons: Photons::TraceOrReuse,
         threads,
     };
-    pipeline::methods::render(&run, &|_| {}).unwrap_or_else(|e| panic!("{e}"))
+    render::methods::render(&run, &|_| {}).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// [`render_in`] for the methods that read no photon map (the cache is never touched).
@@ -318,20 +319,19 @@ fn path_without_its_caustics_plus_the_splat_is_the_path_tracer() {
     let runs = worksheet_runs();
     // The layers partition path space: their classes are disjoint and cover every class.
     for r in &runs.path_splat {
-        let mut classes: Vec<&str> = r.layers.iter().flat_map(|l| l.classes.clone()).collect();
+        let mut classes: Vec<Class> = r.layers.iter().flat_map(|l| l.classes.clone()).collect();
         let n = classes.len();
         classes.sort_unstable();
         classes.dedup();
         assert_eq!(classes.len(), n, "a class is estimated twice: {classes:?}");
-        let mut all = CLASSES.to_vec();
-        all.sort_unstable();
-        assert_eq!(classes, all, "the layers do not cover every class");
+        assert_eq!(classes, Class::ALL, "the layers do not cover every class");
         for l in &r.layers {
-            let (count, kind) = if l.classes == ["caustic"] || l.classes == ["caustic_indirect"] {
-                (SPLAT_PHOTONS, CountKind::PhotonPaths)
-            } else {
-                (PATH_SPLAT_SPP as u64, CountKind::Spp)
-            };
+            let (count, kind) =
+                if l.classes == [Class::Caustic] || l.classes == [Class::CausticIndirect] {
+                    (SPLAT_PHOTONS, CountKind::PhotonPaths)
+                } else {
+                    (PATH_SPLAT_SPP as u64, CountKind::Spp)
+                };
             assert_eq!((l.count, l.count_kind), (count, kind), "layer {}", l.name);
         }
     }
@@ -463,7 +463,7 @@ fn splatting_keeps_a_bounded_number_of_chunks_alive_and_writes_no_photons() {
             "{} photons ({chunks} chunks): at most {} chunks alive, window {}",
             params.photons, stats.max_in_flight, opts.window
         );
-        assert_eq!(stats.emitted, params.photons);
+        assert_eq!(stats.total, params.photons);
         assert_eq!(consumed.into_inner(), params.photons);
         assert!(
             images[0].iter().any(|p| p.max_element() > 0.0),
@@ -657,7 +657,7 @@ fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
 
     // What makes it hostile, as the footprints' principal semi-axes before the clamps (the
     // singular values of [a b]) show: some photons focus to a point, some spread wide.
-    let max_r = pipeline::splat::max_radius(&scene, &SplatSettings::default());
+    let max_r = render::splat::max_radius(&scene, &SplatSettings::default());
     let axes = |p: &CausticPhoton| {
         let (a, b) = (
             p.a - p.a.dot(p.normal) * p.normal,
@@ -700,16 +700,16 @@ fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
         .collect();
     let eyes = EyeIndex::new(grid);
     let settings = SplatSettings::default();
-    let max_r = pipeline::splat::max_radius(&scene, &settings);
+    let max_r = render::splat::max_radius(&scene, &settings);
     let h2 = (H as f64).powi(2);
-    let mut scratch = pipeline::splat::Scratch::default();
+    let mut scratch = render::splat::Scratch::default();
     let mut out = Vec::new();
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for p in &ps {
         out.clear();
         let one = std::slice::from_ref(p);
         let iso = settings.isotropic_radius;
-        pipeline::splat::splat(&eyes, one, max_r, iso, &mut scratch, &mut out);
+        render::splat::splat(&eyes, one, max_r, iso, &mut scratch, &mut out);
         let kept = out.iter().map(|(_, v)| v.max_element()).sum::<f64>() * h2
             / p.flux.max_element() as f64;
         (lo, hi) = (lo.min(kept), hi.max(kept));

@@ -1,12 +1,12 @@
 //! Stochastic progressive photon mapping end to end (issue 10), through
-//! `pipeline::methods::render`: on scenes with a closed-form answer the estimate converges to
+//! `render::methods::render`: on scenes with a closed-form answer the estimate converges to
 //! it at the rate its radius schedule predicts, its snapshots are the images a shorter run
 //! makes, and its images are the same bit for bit on 1 and 2 threads.
 
 use glam::DVec3;
 use math::analytic::polygon_irradiance;
-use pipeline::methods::CountKind;
-use pipeline::{Overrides, Rendered};
+use render::methods::CountKind;
+use render::{Overrides, Rendered};
 use scene::{Method, Scene};
 use std::path::Path;
 use tests::scenes_dir;
@@ -47,13 +47,13 @@ fn render_method(scene: &Scene, method: Method, passes: u32, threads: Option<usi
 /// What the method `o` names renders (these methods read no photon cache).
 fn render_with(scene: &Scene, o: &Overrides, threads: Option<usize>) -> Rendered {
     let cache = Path::new("/nonexistent/photonflow-it-sppm-cache");
-    pipeline::evidence::render_image(scene, o, cache, threads)
+    lab::evidence::render_image(scene, o, cache, threads)
         .unwrap_or_else(|e| panic!("{e}"))
         .1
 }
 
 /// The layers of a snapshot (or of the run, `passes = None`).
-fn layers_at(r: &Rendered, passes: Option<u32>) -> &[pipeline::methods::Layer] {
+fn layers_at(r: &Rendered, passes: Option<u32>) -> &[render::methods::Layer] {
     match passes {
         None => &r.layers,
         Some(p) => {

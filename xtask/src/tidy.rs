@@ -28,9 +28,26 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ),
     // The compositing stage: images in, an image out.
     ("composite", &["film"]),
-    // The stages wired as a library: above every stage, below the binary only.
+    // The channel machinery: knows no photon, no scene.
+    ("flow", &[]),
+    // The photon stage: photon files are its contract; it never sees `density` or `eye`.
     (
-        "pipeline",
+        "photons",
+        &[
+            "math",
+            "geom",
+            "scene",
+            "bsdf",
+            "film",
+            "store",
+            "emit",
+            "composite",
+            "flow",
+        ],
+    ),
+    // The eye side wired as a library: above every stage, below `lab` and the binary.
+    (
+        "render",
         &[
             "math",
             "geom",
@@ -42,6 +59,27 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "emit",
             "density",
             "composite",
+            "flow",
+            "photons",
+        ],
+    ),
+    // Studies built on `render`, which never imports them.
+    (
+        "lab",
+        &[
+            "math",
+            "geom",
+            "scene",
+            "bsdf",
+            "film",
+            "store",
+            "eye",
+            "emit",
+            "density",
+            "composite",
+            "flow",
+            "photons",
+            "render",
         ],
     ),
     ("xtask", &[]),
@@ -125,9 +163,18 @@ mod tests {
     /// (images where it is told).
     #[test]
     fn libraries_do_no_io_of_their_own() {
-        // `pipeline` reads and writes photon caches and run directories, at paths its caller
-        // (the binary, or a test) passes in.
-        let io_crates = ["scene", "store", "film", "pipeline", "photonflow"];
+        // `photons` reads and writes photon caches and shard directories, `render` run
+        // directories and image shards, `lab` its reports and the reference it caches, all
+        // at paths their caller (the binary, or a test) passes in.
+        let io_crates = [
+            "scene",
+            "store",
+            "film",
+            "photons",
+            "render",
+            "lab",
+            "photonflow",
+        ];
         for krate in our_crates() {
             if io_crates.contains(&krate.as_str()) {
                 continue;

@@ -31,7 +31,8 @@ mod meta;
 pub mod shards;
 
 pub use combine::{Composite, CompositeLayer, Input, composite};
-pub use meta::{Class, CountKind, LayerMeta, Meta};
+pub use film::Class;
+pub use meta::{CountKind, LayerMeta, Meta};
 
 #[cfg(test)]
 mod tests;

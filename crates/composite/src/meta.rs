@@ -1,69 +1,8 @@
 //! What a run says about itself: the `image.json` contract, parsed from and written to JSON.
 
+use film::Class;
 use serde_json::{Map, Value, json};
 use std::fmt;
-
-/// The five light-path classes (Heckbert's notation; `D` diffuse, `S` specular). Every path
-/// from a light `L` to the eye `E` falls in exactly one, so layers over disjoint class sets
-/// add up without counting any light twice. The order of the variants is the canonical order
-/// used for sorting classes and layers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Class {
-    /// `L S* E`: light seen directly or through specular bounces.
-    Emitted,
-    /// `L D S* E`: one diffuse bounce, lit straight from the light.
-    Direct,
-    /// `L D (S* D)+ S* E`: two or more diffuse bounces, no specular before the first.
-    Indirect,
-    /// `L S+ D S* E`: a caustic, one diffuse bounce after specular ones.
-    Caustic,
-    /// `L S+ D (S* D)+ S* E`: a caustic that is then reflected diffusely again.
-    CausticIndirect,
-}
-
-impl Class {
-    /// All classes, in canonical order.
-    pub const ALL: [Class; 5] = [
-        Class::Emitted,
-        Class::Direct,
-        Class::Indirect,
-        Class::Caustic,
-        Class::CausticIndirect,
-    ];
-
-    /// The name used in `image.json`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Class::Emitted => "emitted",
-            Class::Direct => "direct",
-            Class::Indirect => "indirect",
-            Class::Caustic => "caustic",
-            Class::CausticIndirect => "caustic_indirect",
-        }
-    }
-
-    /// The class of a name used in `image.json`, if it is one.
-    pub fn from_name(name: &str) -> Option<Class> {
-        Class::ALL.into_iter().find(|c| c.name() == name)
-    }
-
-    /// The paths of the class as a regular expression over `L`, `D`, `S`, `E`.
-    pub fn paths(self) -> &'static str {
-        match self {
-            Class::Emitted => "L S* E",
-            Class::Direct => "L D S* E",
-            Class::Indirect => "L D (S* D)+ S* E",
-            Class::Caustic => "L S+ D S* E",
-            Class::CausticIndirect => "L S+ D (S* D)+ S* E",
-        }
-    }
-}
-
-impl fmt::Display for Class {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
 
 /// What a layer's count counts. Layers of one name are averaged by count, which is only
 /// meaningful when every input counts the same thing.
@@ -240,12 +179,7 @@ impl Meta {
                 let s = c
                     .as_str()
                     .ok_or_else(|| format!("layer '{name}': class {c} is not a string"))?;
-                let class = Class::from_name(s).ok_or_else(|| {
-                    format!(
-                        "layer '{name}': unknown class \"{s}\" (expected one of emitted, direct, \
-                         indirect, caustic, caustic_indirect)"
-                    )
-                })?;
+                let class: Class = s.parse().map_err(|e| format!("layer '{name}': {e}"))?;
                 cs.push(class);
             }
             let own = match counts_obj.and_then(|m| m.get(name)) {

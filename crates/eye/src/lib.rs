@@ -3,7 +3,7 @@
 //!
 //! Key decision: **every contribution is classified by the path's regular expression at the
 //! moment it is added, and lands in exactly one layer** (`emitted`, `direct`, `indirect`,
-//! `caustic`, `caustic_indirect`; see [`Part`]). Why: the photon stage will estimate caustics
+//! `caustic`, `caustic_indirect`; see [`Class`]). Why: the photon stage will estimate caustics
 //! (paths `L S+ D S* E`) by splatting, and the two stages may only be added if they partition
 //! path space. Keeping the classification inside the tracer, next to the MIS weights that
 //! decide which strategy owns which path, makes that partition one `match` to audit; the
@@ -33,7 +33,8 @@ mod render;
 mod vertices;
 mod visible;
 
-pub use path::{Part, PathOptions, PathTracer, Radiance};
+pub use film::Class;
+pub use path::{PathOptions, PathTracer, Radiance};
 pub use photon::{Irradiance, MapLookup, render_final_gather, render_global_direct};
 pub use render::{RenderOptions, on_threads, render};
 pub use vertices::{EyeVertex, VertexOptions, eye_vertices, pass_seed};

@@ -1,68 +1,22 @@
 //! The path loop: NEE + BSDF sampling with MIS, Russian roulette, and the classification of
-//! every contribution into one [`Part`].
+//! every contribution into one [`Class`].
 
 use bsdf::TransportMode;
+use film::Class;
 use geom::Ray;
 use glam::Vec3;
 use math::{Frame, Sampler, power_heuristic};
 use scene::{Scene, sides_agree};
 
-/// Which family of light paths a contribution belongs to (Heckbert's notation, read from the
-/// light: `L` light, `S` specular (delta) bounce, `D` non-delta bounce, `E` eye). The parts
-/// partition path space; their sum is the full image.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Part {
-    /// `L S* E`: emission seen directly or through specular chains.
-    Emitted,
-    /// `L D S* E`: light arriving straight at the first non-delta vertex from the eye,
-    /// by NEE or by a BSDF sample hitting the light (MIS-weighted).
-    Direct,
-    /// `L D (S* D)+ S* E`: light arriving without a specular bounce at the second or a later
-    /// non-delta vertex from the eye (NEE, or a MIS-weighted BSDF hit of the light).
-    Indirect,
-    /// `L S+ D S* E`: the specular chain from the light ends on the first non-delta vertex
-    /// from the eye.
-    Caustic,
-    /// `L S+ D (S* D)+ S* E`: the specular chain from the light ends on a later non-delta
-    /// vertex (caustics seen through at least one more diffuse bounce).
-    CausticIndirect,
-}
-
-impl Part {
-    pub const ALL: [Part; 5] = [
-        Part::Emitted,
-        Part::Direct,
-        Part::Indirect,
-        Part::Caustic,
-        Part::CausticIndirect,
-    ];
-
-    /// The film layer name.
-    pub const fn name(self) -> &'static str {
-        match self {
-            Part::Emitted => "emitted",
-            Part::Direct => "direct",
-            Part::Indirect => "indirect",
-            Part::Caustic => "caustic",
-            Part::CausticIndirect => "caustic_indirect",
-        }
-    }
-
-    /// True for both caustic layers.
-    pub const fn is_caustic(self) -> bool {
-        matches!(self, Part::Caustic | Part::CausticIndirect)
-    }
-}
-
-/// One path's radiance estimate, split by [`Part`].
+/// One path's radiance estimate, split by [`Class`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Radiance {
-    /// Indexed by `Part as usize`, in [`Part::ALL`] order.
+    /// Indexed by `Class as usize`, in [`Class::ALL`] order.
     pub parts: [Vec3; 5],
 }
 
 impl Radiance {
-    pub fn get(&self, part: Part) -> Vec3 {
+    pub fn get(&self, part: Class) -> Vec3 {
         self.parts[part as usize]
     }
 
@@ -72,7 +26,7 @@ impl Radiance {
     }
 
     #[inline]
-    fn add(&mut self, part: Part, v: Vec3) {
+    fn add(&mut self, part: Class, v: Vec3) {
         self.parts[part as usize] += v;
     }
 }
@@ -86,11 +40,11 @@ pub struct PathOptions {
     /// Russian roulette applies once this many bounces have been made.
     pub rr_depth: u32,
     /// When false, the paths photon splatting owns at first eye vertices are left out:
-    /// `L S+ D S* E` with `D` the first non-delta vertex from the eye ([`Part::Caustic`]
+    /// `L S+ D S* E` with `D` the first non-delta vertex from the eye ([`Class::Caustic`]
     /// stays zero); nothing else changes.
     pub caustics: bool,
     /// When false, caustics seen after a further diffuse bounce are left out too:
-    /// `L S+ D (S* D)+ S* E` ([`Part::CausticIndirect`] stays zero), which splatting onto
+    /// `L S+ D (S* D)+ S* E` ([`Class::CausticIndirect`] stays zero), which splatting onto
     /// later eye vertices owns. So `path` without both plus both splatted layers is the
     /// whole image.
     pub caustic_indirect: bool,
@@ -98,10 +52,10 @@ pub struct PathOptions {
 
 impl PathOptions {
     /// Whether a path tracer with these options estimates `part`.
-    pub const fn estimates(&self, part: Part) -> bool {
+    pub const fn estimates(&self, part: Class) -> bool {
         match part {
-            Part::Caustic => self.caustics,
-            Part::CausticIndirect => self.caustic_indirect,
+            Class::Caustic => self.caustics,
+            Class::CausticIndirect => self.caustic_indirect,
             _ => true,
         }
     }
@@ -135,7 +89,7 @@ impl<'a> PathTracer<'a> {
     }
 
     /// Whether this tracer estimates `part` (the two caustic switches can drop a part).
-    pub fn estimates(&self, part: Part) -> bool {
+    pub fn estimates(&self, part: Class) -> bool {
         self.opts.estimates(part)
     }
 
@@ -167,7 +121,7 @@ impl<'a> PathTracer<'a> {
                 let le = lights.le(light, ray.d);
                 if le != Vec3::ZERO {
                     if diffuse_vertices == 0 {
-                        out.add(Part::Emitted, beta * le);
+                        out.add(Class::Emitted, beta * le);
                     } else if let Some((p, pdf_bsdf)) = from_diffuse {
                         let pdf_light = lights.pdf(light, p, hit.point.p);
                         let w = power_heuristic(1, pdf_bsdf, 1, pdf_light);
@@ -176,10 +130,10 @@ impl<'a> PathTracer<'a> {
                         // Specular chain from a diffuse vertex to the light: NEE's shadow
                         // rays cannot follow it, so BSDF sampling owns it (weight 1).
                         if self.opts.caustic_indirect {
-                            out.add(Part::CausticIndirect, beta * le);
+                            out.add(Class::CausticIndirect, beta * le);
                         }
                     } else if self.opts.caustics {
-                        out.add(Part::Caustic, beta * le);
+                        out.add(Class::Caustic, beta * le);
                     }
                 }
             }
@@ -253,10 +207,10 @@ impl<'a> PathTracer<'a> {
 }
 
 #[inline]
-fn direct_or_indirect(diffuse_vertices: u32) -> Part {
+fn direct_or_indirect(diffuse_vertices: u32) -> Class {
     if diffuse_vertices == 1 {
-        Part::Direct
+        Class::Direct
     } else {
-        Part::Indirect
+        Class::Indirect
     }
 }

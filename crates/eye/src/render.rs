@@ -1,6 +1,6 @@
-//! Parallel rendering over tiles into a film with one layer per [`Part`].
+//! Parallel rendering over tiles into a film with one layer per [`Class`].
 
-use crate::{Part, PathOptions, PathTracer};
+use crate::{Class, PathOptions, PathTracer};
 use film::{Film, TileBuffer, tiles};
 use math::{Rng, Sampler, SobolSampler, mix64};
 use rayon::prelude::*;
@@ -42,8 +42,8 @@ impl RenderOptions {
     }
 }
 
-/// Renders the scene from its camera into a film with the layers named by [`Part::name`], in
-/// [`Part::ALL`] order. Each layer holds per-pixel sums of sample contributions (and the
+/// Renders the scene from its camera into a film with the layers named by [`Class::name`], in
+/// [`Class::ALL`] order. Each layer holds per-pixel sums of sample contributions (and the
 /// sample count as weight): resolve with `Normalize::Constant(spp)` (or `Normalize::Weight`).
 ///
 /// The film is bit-identical for any `threads` and `tile`: pixel sample `s` of pixel
@@ -64,7 +64,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) + Syn
             ..PathOptions::from_scene(scene)
         },
     );
-    let names = Part::ALL.map(Part::name);
+    let names = Class::ALL.map(Class::name);
     match scene.render().sampler {
         scene::SamplerKind::Sobol => render_layers(
             scene,
@@ -73,13 +73,13 @@ pub fn render(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) + Syn
             progress,
             &|ray, s: &mut SobolSampler| {
                 let l = tracer.li(ray, s);
-                Part::ALL.map(|p| l.get(p))
+                Class::ALL.map(|p| l.get(p))
             },
         ),
         scene::SamplerKind::Independent => {
             render_layers(scene, opts, names, progress, &|ray, rng: &mut Rng| {
                 let l = tracer.li(ray, rng);
-                Part::ALL.map(|p| l.get(p))
+                Class::ALL.map(|p| l.get(p))
             })
         }
     }

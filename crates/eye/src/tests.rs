@@ -3,7 +3,7 @@
 //! errors computed from the samples, and each test checks that its standard error is small
 //! enough for the comparison to mean something.
 
-use crate::{Part, PathOptions, PathTracer, RenderOptions, render};
+use crate::{Class, PathOptions, PathTracer, RenderOptions, render};
 use film::{Film, Normalize};
 use geom::Ray;
 use glam::{DVec3, Vec3};
@@ -100,9 +100,9 @@ fn furnace_radiance_is_le_over_one_minus_rho() {
             let d = sample_uniform_sphere(rng.uniform2());
             let l = tracer.li(Ray::new(Vec3::ZERO, d), &mut rng);
             total.push(luminance(l.total()));
-            emitted.push(luminance(l.get(Part::Emitted)));
-            assert_eq!(l.get(Part::Caustic), Vec3::ZERO);
-            assert_eq!(l.get(Part::CausticIndirect), Vec3::ZERO);
+            emitted.push(luminance(l.get(Class::Emitted)));
+            assert_eq!(l.get(Class::Caustic), Vec3::ZERO);
+            assert_eq!(l.get(Class::CausticIndirect), Vec3::ZERO);
         }
         let rho = rho as f64;
         let limit = 1.0 / (1.0 - rho);
@@ -183,10 +183,10 @@ fn plane_radiance_matches_polygon_irradiance() {
         for i in 0..8_000 {
             let mut rng = Rng::for_index(7 + k as u64, i);
             let r = tracer.li(Ray::new(o, (p - o).normalize()), &mut rng);
-            assert_eq!(r.get(Part::Emitted), Vec3::ZERO);
-            assert_eq!(r.get(Part::Indirect), Vec3::ZERO);
-            assert_eq!(r.get(Part::Caustic), Vec3::ZERO);
-            l.push(luminance(r.get(Part::Direct)));
+            assert_eq!(r.get(Class::Emitted), Vec3::ZERO);
+            assert_eq!(r.get(Class::Indirect), Vec3::ZERO);
+            assert_eq!(r.get(Class::Caustic), Vec3::ZERO);
+            l.push(luminance(r.get(Class::Direct)));
         }
         let exact =
             0.5 / std::f64::consts::PI * polygon_irradiance(p.as_dvec3(), DVec3::Y, &polygon, 10.0);
@@ -239,7 +239,7 @@ fn in_shadow_cone(f: DVec3) -> bool {
     })
 }
 
-fn layer(film: &Film, part: Part, spp: u32) -> film::Image {
+fn layer(film: &Film, part: Class, spp: u32) -> film::Image {
     film.layer(part.name())
         .unwrap()
         .resolve(Normalize::Constant(spp as f64))
@@ -276,10 +276,10 @@ fn caustic_switch_removes_exactly_the_caustic_layers() {
         &|_| {},
     );
     for part in [
-        Part::Emitted,
-        Part::Direct,
-        Part::Indirect,
-        Part::CausticIndirect,
+        Class::Emitted,
+        Class::Direct,
+        Class::Indirect,
+        Class::CausticIndirect,
     ] {
         assert_eq!(
             full.layer(part.name()),
@@ -289,7 +289,7 @@ fn caustic_switch_removes_exactly_the_caustic_layers() {
         );
     }
     {
-        let part = Part::Caustic;
+        let part = Class::Caustic;
         let l = without.layer(part.name()).unwrap();
         assert!(
             layer(&without, part, spp)
@@ -312,7 +312,12 @@ fn caustic_switch_removes_exactly_the_caustic_layers() {
         },
         &|_| {},
     );
-    for part in [Part::Emitted, Part::Direct, Part::Indirect, Part::Caustic] {
+    for part in [
+        Class::Emitted,
+        Class::Direct,
+        Class::Indirect,
+        Class::Caustic,
+    ] {
         assert_eq!(
             with.layer(part.name()),
             neither.layer(part.name()),
@@ -321,14 +326,14 @@ fn caustic_switch_removes_exactly_the_caustic_layers() {
         );
     }
     let zero = |f: &Film| {
-        layer(f, Part::CausticIndirect, 16)
+        layer(f, Class::CausticIndirect, 16)
             .data
             .iter()
             .all(|p| *p == [0.0; 3])
     };
     assert!(!zero(&with) && zero(&neither));
 
-    let caustic = layer(&full, Part::Caustic, spp);
+    let caustic = layer(&full, Class::Caustic, spp);
     let (mut inside, mut outside, mut focus) =
         (Stats::default(), Stats::default(), Stats::default());
     let floor = scene.material_of("white").unwrap();
@@ -404,8 +409,8 @@ fn films_are_bit_identical_for_any_thread_count_and_tile_size() {
     let c = run(2, 3);
     assert_eq!(
         a.layer_names(),
-        Part::ALL.map(Part::name).to_vec(),
-        "layers in Part order"
+        Class::ALL.map(Class::name).to_vec(),
+        "layers in Class order"
     );
     // Film's PartialEq compares every f64 sum and weight exactly.
     assert!(a == b, "1 vs 2 threads differ");
@@ -432,7 +437,7 @@ fn cornell_layers_are_finite_and_non_negative() {
             },
             &|_| {},
         );
-        for part in Part::ALL {
+        for part in Class::ALL {
             let img = layer(&film, part, spp);
             let mut sum = 0.0f64;
             for p in &img.data {

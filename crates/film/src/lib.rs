@@ -14,8 +14,12 @@
 //!   (with `math`'s counter-based RNG this makes whole renders reproducible).
 //! - **The caller picks every path**, and writes are atomic (temp file + rename, see
 //!   [`write_atomic`]); failures are [`FilmError`]s naming the file, never panics.
+//! - **Light-path classes are spelled once**, here ([`Class`]): the eye pass names its layers
+//!   by them and compositing reads them back from `image.json`, so both sides share one
+//!   type, one order and one set of names.
 
 mod bias;
+mod class;
 mod error;
 mod film;
 mod flip;
@@ -25,6 +29,7 @@ mod metrics;
 mod sums;
 
 pub use bias::{BiasVariance, RegionSums};
+pub use class::Class;
 pub use error::FilmError;
 pub use film::{Film, Layer, Normalize, Rect, TileBuffer, tiles};
 pub use flip::{FlipMap, flip};

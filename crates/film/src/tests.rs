@@ -664,3 +664,53 @@ fn sums_files_round_trip_exactly_and_refuse_damage() {
     let e = read_sums(&p).unwrap_err().to_string();
     assert!(e.contains("bytes"), "{e}");
 }
+
+// ---------------------------------------------------------------- class
+
+#[test]
+fn class_names_round_trip_through_from_name_from_str_and_display() {
+    let names: Vec<&str> = Class::ALL.iter().map(|c| c.name()).collect();
+    assert_eq!(
+        names,
+        [
+            "emitted",
+            "direct",
+            "indirect",
+            "caustic",
+            "caustic_indirect"
+        ]
+    );
+    for c in Class::ALL {
+        assert_eq!(Class::from_name(c.name()), Some(c));
+        assert_eq!(c.name().parse::<Class>(), Ok(c));
+        assert_eq!(c.to_string(), c.name());
+        assert_eq!(c.to_string().parse::<Class>(), Ok(c));
+    }
+}
+
+#[test]
+fn unknown_class_names_are_refused_naming_the_name_and_the_valid_ones() {
+    for bad in ["caustics", "", "Emitted", "caustic-indirect", " direct"] {
+        assert_eq!(Class::from_name(bad), None, "{bad:?}");
+        let e = bad.parse::<Class>().unwrap_err();
+        assert!(e.contains(&format!("\"{bad}\"")), "{e}");
+        for c in Class::ALL {
+            assert!(e.contains(c.name()), "{e}");
+        }
+        assert!(!e.contains('\n'), "{e}");
+    }
+}
+
+#[test]
+fn class_all_is_sorted_and_lists_each_class_once() {
+    assert!(Class::ALL.is_sorted_by(|a, b| a < b), "{:?}", Class::ALL);
+    let mut sorted = Class::ALL;
+    sorted.reverse();
+    sorted.sort();
+    assert_eq!(sorted, Class::ALL);
+    for (i, c) in Class::ALL.into_iter().enumerate() {
+        assert_eq!(c as usize, i, "{c:?}");
+    }
+    let caustic: Vec<Class> = Class::ALL.into_iter().filter(|c| c.is_caustic()).collect();
+    assert_eq!(caustic, [Class::Caustic, Class::CausticIndirect]);
+}

@@ -117,7 +117,7 @@ fn load(dir: &Path) -> Result<::composite::Input, String> {
     for l in &meta.layers {
         // Layer names are checked to be plain file names ([A-Za-z0-9_-]+) by `from_json`.
         let path = dir.join("layers").join(format!("{}.exr", l.name));
-        let img = pipeline::output::read_exr(&path)?;
+        let img = render::output::read_exr(&path)?;
         layers.push((l.name.clone(), img));
     }
     Ok(::composite::Input {

@@ -7,9 +7,10 @@
 //! (the Ctrl-C handler, printing the error, the exit code).
 
 mod composite;
+mod paths;
 
 use clap::{Parser, Subcommand};
-use pipeline::{Overrides, Photons, RenderRequest};
+use render::{Overrides, Photons, RenderRequest};
 use scene::{Method, Scene};
 use std::path::{Path, PathBuf};
 
@@ -118,8 +119,8 @@ enum Cmd {
         /// Render only shard I of N (counted from 0) of the run: `path` by its passes of
         /// samples, `caustic-splat` by its passes, into a shard directory (--out, default
         /// out/shards/...) for `merge`.
-        #[arg(long, value_parser = pipeline::shard::ShardId::parse)]
-        shard: Option<pipeline::shard::ShardId>,
+        #[arg(long, value_parser = render::shard::ShardId::parse)]
+        shard: Option<render::shard::ShardId>,
     },
     /// Estimate an image from cached photon sets (never traces).
     Estimate {
@@ -205,8 +206,8 @@ enum Cmd {
         force: bool,
         /// Trace only shard I of N (counted from 0): photon paths [I P / N, (I + 1) P / N),
         /// into a shard directory (--out) for `merge`, not into the cache.
-        #[arg(long, value_parser = pipeline::shard::ShardId::parse)]
-        shard: Option<pipeline::shard::ShardId>,
+        #[arg(long, value_parser = render::shard::ShardId::parse)]
+        shard: Option<render::shard::ShardId>,
         /// The shard directory (default: out/shards/<scene dir>-<stem>-trace-I-of-N).
         #[arg(long, requires = "shard")]
         out: Option<PathBuf>,
@@ -291,7 +292,7 @@ struct PhotonArgs {
     k: Option<usize>,
     /// Kernel of the global-map estimate: uniform, silverman, epanechnikov, triweight,
     /// gaussian, gaussian-jensen, cone, cone:K.
-    #[arg(long, value_parser = pipeline::settings::parse_kernel)]
+    #[arg(long, value_parser = render::settings::parse_kernel)]
     kernel: Option<density::Kernel>,
     /// Topological test: keep photons whose direction from the estimation point is within
     /// |cos| < EPS of the tangent plane.
@@ -362,7 +363,7 @@ fn load(path: &Path, seed: Option<u64>) -> Result<Scene, String> {
 
 /// `render` and `estimate`: the one path through the library, then a summary line.
 fn render(scene: &Scene, req: RenderRequest) -> Result<(), String> {
-    let r = pipeline::render(scene, &req)?;
+    let r = render::render(scene, &req)?;
     println!(
         "rendered {} in {:.2} s; wrote {}/image.{{exr,png,json}}, layers/, scene.toml",
         r.settings.method,
@@ -465,7 +466,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
                 ),
                 None => None,
             };
-            pipeline::bench::rays(&scene, runs, rays, compare, ray_dir.as_deref(), peer)
+            lab::bench::rays(&scene, runs, rays, compare, ray_dir.as_deref(), peer)
         }
         Cmd::Render {
             scene,
@@ -483,6 +484,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
             if let Some(shard) = shard {
                 return render_shard(&s, &overrides, &photon, &image, shard);
             }
+            let out = out_dir(&s, &overrides, &photon, image.out);
             render(
                 &s,
                 RenderRequest {
@@ -490,7 +492,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
                     cache: &photon.cache,
                     photons: Photons::TraceOrReuse,
                     threads: image.threads,
-                    out: image.out,
+                    out,
                     exposure: image.exposure,
                     reference: photon.reference.as_deref(),
                     label: photon.label.clone(),
@@ -503,7 +505,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
             photon,
             image,
         } => {
-            let reads_maps = |m: Method| pipeline::methods::spec(m).photon_maps;
+            let reads_maps = |m: Method| render::methods::spec(m).photon_maps;
             if let Some(m) = method
                 && !reads_maps(m)
             {
@@ -517,14 +519,16 @@ fn run(cmd: Cmd) -> Result<(), String> {
                 m if reads_maps(m) => m,
                 _ => Method::GlobalDirect,
             });
+            let overrides = photon.overrides(Some(method), image.spp);
+            let out = out_dir(&s, &overrides, &photon, image.out);
             render(
                 &s,
                 RenderRequest {
-                    overrides: photon.overrides(Some(method), image.spp),
+                    overrides,
                     cache: &photon.cache,
                     photons: Photons::CacheOnly,
                     threads: image.threads,
-                    out: image.out,
+                    out,
                     exposure: image.exposure,
                     reference: photon.reference.as_deref(),
                     label: photon.label.clone(),
@@ -537,8 +541,8 @@ fn run(cmd: Cmd) -> Result<(), String> {
             exposure,
         } => composite::run(&inputs, &out, exposure),
         Cmd::Compare { a, b, mask } => {
-            let m = pipeline::output::compare(&a, &b, mask)?;
-            let flip = pipeline::output::compare_flip(&a, &b, mask)?;
+            let m = render::output::compare(&a, &b, mask)?;
+            let flip = render::output::compare_flip(&a, &b, mask)?;
             println!("{m} flip={flip:.5}");
             Ok(())
         }
@@ -546,14 +550,14 @@ fn run(cmd: Cmd) -> Result<(), String> {
             scene,
             photons,
             runs,
-        } => pipeline::bench::photons(&scene, photons, runs),
-        Cmd::BenchStore { photons, dir } => pipeline::bench::store(photons, &dir),
+        } => lab::bench::photons(&scene, photons, runs),
+        Cmd::BenchStore { photons, dir } => lab::bench::store(photons, &dir),
         Cmd::BenchSplat {
             scene,
             photons,
             runs,
-        } => pipeline::bench::splat(&scene, photons, runs),
-        Cmd::BenchKnn { photons, queries } => pipeline::bench::knn(photons, queries),
+        } => lab::bench::splat(&scene, photons, runs),
+        Cmd::BenchKnn { photons, queries } => lab::bench::knn(photons, queries),
         Cmd::BenchAccuracy {
             scene,
             reference,
@@ -561,11 +565,11 @@ fn run(cmd: Cmd) -> Result<(), String> {
             peer,
             dir,
         } => {
-            let peers: Vec<pipeline::accuracy::Peer> = peer
+            let peers: Vec<lab::accuracy::Peer> = peer
                 .into_iter()
-                .map(|(name, command)| pipeline::accuracy::Peer { name, command })
+                .map(|(name, command)| lab::accuracy::Peer { name, command })
                 .collect();
-            pipeline::accuracy::accuracy(&scene, reference.as_deref(), reference_spp, &peers, &dir)
+            lab::accuracy::accuracy(&scene, reference.as_deref(), reference_spp, &peers, &dir)
         }
         Cmd::Evidence {
             scene,
@@ -577,7 +581,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
             only,
             out,
             threads,
-        } => pipeline::evidence::run(&pipeline::evidence::EvidenceArgs {
+        } => lab::evidence(&lab::evidence::EvidenceArgs {
             scene,
             reference,
             reference_spp,
@@ -599,9 +603,9 @@ fn run(cmd: Cmd) -> Result<(), String> {
             threads,
         } => {
             let s = load(&scene, None)?;
-            pipeline::worksheet::run(
+            lab::worksheet::run(
                 &s,
-                &pipeline::worksheet::WorksheetArgs {
+                &lab::worksheet::WorksheetArgs {
                     scene,
                     photons,
                     k,
@@ -629,9 +633,8 @@ fn run(cmd: Cmd) -> Result<(), String> {
                 ..Overrides::default()
             };
             if let Some(shard) = shard {
-                let out =
-                    out.unwrap_or_else(|| pipeline::shard::default_out(&scene, "trace", shard));
-                let m = pipeline::shard::trace(&s, &overrides, shard, &out, threads)?;
+                let out = out.unwrap_or_else(|| paths::shard_out(&scene, "trace", shard));
+                let m = render::trace_shard(&s, &overrides, shard, &out, threads)?;
                 println!(
                     "traced shard {shard}: photon paths {}..{} of {} in {:.2} s into {}",
                     m.range[0],
@@ -642,13 +645,22 @@ fn run(cmd: Cmd) -> Result<(), String> {
                 );
                 return Ok(());
             }
-            pipeline::trace(&s, &overrides, &cache, threads, force).map(|_| ())
+            render::trace(&s, &overrides, &cache, threads, force).map(|_| ())
         }
         Cmd::Merge { inputs, out } => {
-            println!("{}", pipeline::shard::merge(&inputs, &out)?);
+            println!("{}", render::shard::merge(&inputs, &out)?);
             Ok(())
         }
     }
+}
+
+/// `--out`, or `out/<scene dir>-<scene stem>-<label or method>`.
+fn out_dir(scene: &Scene, o: &Overrides, photon: &PhotonArgs, out: Option<PathBuf>) -> PathBuf {
+    out.unwrap_or_else(|| {
+        let method = o.method.unwrap_or(scene.render().method);
+        let label = photon.label.clone().unwrap_or_else(|| method.name());
+        paths::run_out(&scene.path, &label)
+    })
 }
 
 /// `render --shard`: the shard's blocks of the run into a shard directory.
@@ -657,9 +669,9 @@ fn render_shard(
     overrides: &Overrides,
     photon: &PhotonArgs,
     image: &ImageArgs,
-    shard: pipeline::shard::ShardId,
+    shard: render::shard::ShardId,
 ) -> Result<(), String> {
-    let settings = pipeline::Settings::new(scene, overrides)?;
+    let settings = render::Settings::new(scene, overrides)?;
     let label = photon
         .label
         .clone()
@@ -667,15 +679,15 @@ fn render_shard(
     let out = image
         .out
         .clone()
-        .unwrap_or_else(|| pipeline::shard::default_out(&scene.path, &label, shard));
-    let run = pipeline::Run {
+        .unwrap_or_else(|| paths::shard_out(&scene.path, &label, shard));
+    let run = render::Run {
         scene,
         settings: &settings,
         cache: &photon.cache,
         photons: Photons::TraceOrReuse,
         threads: image.threads,
     };
-    let m = pipeline::shard::render(&run, shard, &out)?;
+    let m = render::shard::render(&run, shard, &out)?;
     println!(
         "rendered shard {shard} of {}: {} {} in {:.2} s into {}",
         settings.method,
@@ -688,6 +700,6 @@ fn render_shard(
 }
 
 fn info(path: &Path) -> Result<(), String> {
-    print!("{}", pipeline::describe(&load(path, None)?));
+    print!("{}", render::describe(&load(path, None)?));
     Ok(())
 }

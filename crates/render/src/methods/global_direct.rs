@@ -3,6 +3,7 @@
 //! and boundary correction.
 
 use super::{CountKind, Rendered, Run};
+use film::Class;
 
 pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
     let inputs = super::photon_inputs(run, false)?;
@@ -19,10 +20,15 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
             &film,
             spp,
             &[
-                ("emitted", &["emitted"], spp as u64, CountKind::Spp),
+                ("emitted", &[Class::Emitted], spp as u64, CountKind::Spp),
                 (
                     "global",
-                    &["direct", "indirect", "caustic", "caustic_indirect"],
+                    &[
+                        Class::Direct,
+                        Class::Indirect,
+                        Class::Caustic,
+                        Class::CausticIndirect,
+                    ],
                     photons,
                     CountKind::PhotonPaths,
                 ),

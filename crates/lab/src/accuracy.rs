@@ -3,8 +3,8 @@
 //! only ratios taken together mean anything). Each run is a whole `render` command (photons
 //! traced anew into an empty cache, outputs written), timed from start to finish.
 
-use crate::methods::Photons;
-use crate::{Overrides, RenderRequest};
+use render::methods::Photons;
+use render::{Overrides, RenderRequest};
 use scene::{Method, Scene};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -67,7 +67,7 @@ pub(crate) fn reference(
 ) -> Result<PathBuf, String> {
     if let Some(p) = given {
         // Checked now, before any rung writes a run directory.
-        crate::read_reference(scene, p)?;
+        render::read_reference(scene, p)?;
         return Ok(p.to_path_buf());
     }
     let cached = dir.join(format!("reference-{:016x}-{spp}spp", scene.view_hash));
@@ -103,7 +103,7 @@ fn run_one(
     // A photon cache left from another run would make tracing free.
     let _ = std::fs::remove_dir_all(cache);
     let t0 = Instant::now();
-    let summary = crate::render(
+    let summary = render::render(
         scene,
         &RenderRequest {
             overrides: Overrides {
@@ -115,7 +115,7 @@ fn run_one(
             cache,
             photons: Photons::TraceOrReuse,
             threads: None,
-            out: Some(out.to_path_buf()),
+            out: out.to_path_buf(),
             exposure: 0.0,
             reference,
             label: None,
@@ -239,7 +239,7 @@ pub fn accuracy(
                 peer.name, peer.command
             ));
         }
-        let m = crate::output::compare(&exr, &reference, None)?;
+        let m = render::output::compare(&exr, &reference, None)?;
         println!(
             "{:<13} {seconds:8.2} s  relMSE {:.5} (incl. start-up)",
             peer.name, m.relmse

@@ -6,10 +6,11 @@
 //! biased and where it is noisy. Regions come from the scene's geometry (camera rays through
 //! pixel centres), not from hand-drawn boxes.
 
-use crate::methods::{Photons, Rendered, Run};
-use crate::{Overrides, Settings, worksheet};
+use crate::worksheet;
 use density::Kernel;
 use film::{BiasVariance, Image, Mask};
+use render::methods::{Photons, Rendered, Run};
+use render::{Overrides, Settings};
 use scene::{Material, Method, Scene};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -274,7 +275,7 @@ pub fn render_image(
         photons: Photons::TraceOrReuse,
         threads,
     };
-    let r = crate::methods::render(&run, &|_| {})?;
+    let r = render::methods::render(&run, &|_| {})?;
     let parts: Vec<(&Image, f32)> = r.layers.iter().map(|l| (&l.image, 1.0)).collect();
     let img = film::composite(&parts).map_err(|e| e.to_string())?;
     Ok((img, r))
@@ -422,7 +423,7 @@ pub struct SweepResult {
     pub rung: RungResult,
 }
 
-pub fn run(a: &EvidenceArgs) -> Result<(), String> {
+pub fn run(a: &EvidenceArgs) -> Result<Measured, String> {
     if a.seeds < 2 {
         return Err(format!(
             "--seeds {} must be at least 2 (bias and variance need two runs)",
@@ -508,12 +509,19 @@ pub fn run(a: &EvidenceArgs) -> Result<(), String> {
     if wanted("k-sweep") {
         k_sweep(a, &make, &reference.image, &regions, &cache, &mut ev)?;
     }
-    crate::report::write(&a.out, &ev, &scene, &regions)?;
-    println!(
-        "wrote {} and report.html, evidence.md (tables), evidence.json, maps/, plots/",
-        a.out.join("report.md").display()
-    );
-    Ok(())
+    Ok(Measured {
+        evidence: ev,
+        scene,
+        regions,
+    })
+}
+
+/// What [`run`] measured, for the report: the evidence, the scene it was measured on and the
+/// regions of its image.
+pub struct Measured {
+    pub evidence: Evidence,
+    pub scene: Scene,
+    pub regions: Vec<(&'static str, Mask)>,
 }
 
 /// The worksheet's trade-off itself: the global map shown directly, k swept for each kernel,

@@ -366,9 +366,9 @@ fn random_rays(geo: &Geometry, count: usize, seed: u64) -> Vec<Ray> {
 /// photon files. Median of `runs`.
 pub fn photons(path: &Path, count: u64, runs: usize) -> Result<(), String> {
     let s = scene::Scene::load(path).map_err(|e| e.to_string())?;
-    let params = crate::Settings::new(
+    let params = render::Settings::new(
         &s,
-        &crate::Overrides {
+        &render::Overrides {
             photons: Some(count),
             ..Default::default()
         },
@@ -410,15 +410,16 @@ pub fn photons(path: &Path, count: u64, runs: usize) -> Result<(), String> {
     for threads in [1usize, 2] {
         let mut rates = Vec::new();
         for _ in 0..runs.max(1) {
-            use crate::flow::{self, PipelineOptions, Sink, StoreSink};
-            let key = crate::photon_cache::CacheKey::new(&s, &params);
-            let files: Vec<_> = crate::photon_cache::planned_kinds(&plan)
+            use flow::PipelineOptions;
+            use photons::sinks::{self, Sink, StoreSink};
+            let key = photons::cache::CacheKey::new(&s, &params);
+            let files: Vec<_> = photons::cache::planned_kinds(&plan)
                 .into_iter()
                 .map(|k| (k, key.file(&dir, k)))
                 .collect();
-            let progress = crate::progress::Progress::hidden();
+            let progress = flow::Progress::hidden();
             let mut store = StoreSink::create(&files, &|k| key.header(&s, k))?;
-            let stats = flow::run(
+            let stats = sinks::run(
                 &s,
                 &params,
                 &plan,
@@ -535,9 +536,9 @@ fn peak_rss_mib() -> Option<f64> {
 /// the peak memory before and after splatting ten times more photons (flat if no photon is
 /// kept).
 pub fn splat(path: &Path, photons: u64, runs: usize) -> Result<(), String> {
-    use crate::splat::{Splatter, eye_index};
+    use render::splat::{Splatter, eye_index};
     let s = scene::Scene::load(path).map_err(|e| e.to_string())?;
-    let settings = crate::Settings::new(&s, &crate::Overrides::default())?;
+    let settings = render::Settings::new(&s, &render::Overrides::default())?;
     let sp = settings.estimate.splat;
     let mut params = settings.emit.clone();
     params.photons = photons;

@@ -14,12 +14,12 @@
 //! the chunk's pixel contributions, added in chunk order (so the image is the same for any
 //! thread count).
 
-use crate::flow::{self, PipelineOptions, TraceStats};
 use crate::settings::SplatSettings;
 use density::splat::Footprint;
 use density::{Index, IndexKind, Neighbor};
 use emit::{CausticPhoton, EmitParams};
 use eye::{EyeVertex, VertexOptions};
+use flow::{PipelineOptions, Stats};
 use glam::{DVec3, Vec3};
 use scene::Scene;
 
@@ -256,7 +256,7 @@ impl Splatter<'_> {
         images: &mut [Vec<DVec3>; 2],
         threads: usize,
         progress: &(dyn Fn(u64) + Sync),
-    ) -> Result<TraceStats, String> {
+    ) -> Result<Stats, String> {
         let (scene, params, s, eyes) = (self.scene, self.params, self.settings, self.eyes);
         if s.indirect && images[1].len() != images[0].len() {
             return Err("splatting caustic_indirect needs an image for it".into());

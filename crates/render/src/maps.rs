@@ -3,7 +3,7 @@
 
 use crate::boundary::{MIN_MASS, kernel_mass_on_surface};
 use crate::gather_cache::IrradianceCache;
-use density::{EstimateParams, KnnHint, Neighbor, PhotonMap};
+use density::{EstimateParams, IndexKind, KnnHint, Neighbor, PhotonMap};
 use eye::{Irradiance, MapLookup};
 use glam::Vec3;
 use scene::Scene;
@@ -100,4 +100,38 @@ impl Irradiance for Maps<'_> {
             self.estimate(kind, p, n, hint, &mut st.scratch).0
         })
     }
+}
+
+/// Most photons one map may hold: the kd-tree indexes with u32.
+pub const MAX_MAP_PHOTONS: u64 = u32::MAX as u64 - 1;
+
+/// Loads the cached sets `kinds` of `key` from `dir` as photon maps (never traces: a missing
+/// set is an error that says to run `trace`).
+pub fn load(
+    dir: &std::path::Path,
+    key: &photons::CacheKey,
+    kinds: &[MapKind],
+) -> Result<PerKind<Option<PhotonMap>>, String> {
+    let mut maps: PerKind<Option<PhotonMap>> = PerKind::default();
+    for &kind in kinds {
+        let store = photons::cache::open(dir, key, kind)?;
+        let path = key.file(dir, kind);
+        if store.header().stored > MAX_MAP_PHOTONS {
+            return Err(format!(
+                "{}: {} photons exceed the {MAX_MAP_PHOTONS} one map can index",
+                path.display(),
+                store.header().stored
+            ));
+        }
+        if store.header().stored == 0 && kind == MapKind::Global {
+            eprintln!(
+                "warning: {}: the global photon set is empty",
+                path.display()
+            );
+        }
+        // Photon powers from `emit` already carry the 1/N of the emitted count the header
+        // records (the photon-power invariant), so the map sums them as they are.
+        maps[kind] = Some(PhotonMap::build(store.to_vec(), IndexKind::KdTree));
+    }
+    Ok(maps)
 }

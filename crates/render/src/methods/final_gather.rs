@@ -5,6 +5,7 @@
 
 use super::{CountKind, Rendered, Run};
 use crate::gather_cache::IrradianceCache;
+use film::Class;
 use store::MapKind;
 
 pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
@@ -57,12 +58,17 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
             &film,
             spp,
             &[
-                ("emitted", &["emitted"], spp_count, CountKind::Spp),
-                ("direct", &["direct"], spp_count, CountKind::Spp),
-                ("caustic", &["caustic"], photons, CountKind::PhotonPaths),
+                ("emitted", &[Class::Emitted], spp_count, CountKind::Spp),
+                ("direct", &[Class::Direct], spp_count, CountKind::Spp),
+                (
+                    "caustic",
+                    &[Class::Caustic],
+                    photons,
+                    CountKind::PhotonPaths,
+                ),
                 (
                     "indirect",
-                    &["indirect", "caustic_indirect"],
+                    &[Class::Indirect, Class::CausticIndirect],
                     photons,
                     CountKind::PhotonPaths,
                 ),

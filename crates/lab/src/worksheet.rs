@@ -4,11 +4,11 @@
 //! reference (whole image, and the band along the box's inner edges where topological bias
 //! lives); and writes a Markdown summary beside the images.
 
-use crate::settings::kernel_name;
-use crate::{Overrides, Photons, RenderRequest};
 use density::Kernel;
 use film::{Image, Mask};
 use glam::Vec3;
+use render::settings::kernel_name;
+use render::{Overrides, Photons, RenderRequest};
 use scene::{Material, Scene};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -38,7 +38,7 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
     // rendered: a bad value used to fail only after the reference and two estimates were
     // written.
     for topo in [None, Some(a.topo)] {
-        crate::Settings::new(
+        render::Settings::new(
             scene,
             &Overrides {
                 method: Some(scene::Method::GlobalDirect),
@@ -62,7 +62,7 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
         caustics: Some(true),
         ..Overrides::default()
     };
-    let want = crate::Settings::new(scene, &reference_overrides)?.hash(scene);
+    let want = render::Settings::new(scene, &reference_overrides)?.hash(scene);
     let reusable = std::fs::read_to_string(&reference_json)
         .ok()
         .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
@@ -71,14 +71,14 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
         println!("reference: reusing {}", ref_dir.display());
     } else {
         println!("reference: path tracing at {} spp", a.reference_spp);
-        crate::render(
+        render::render(
             scene,
             &RenderRequest {
                 overrides: reference_overrides,
                 cache: &a.cache,
                 photons: Photons::CacheOnly,
                 threads: a.threads,
-                out: Some(ref_dir.clone()),
+                out: ref_dir.clone(),
                 exposure: 0.0,
                 reference: None,
                 label: None,
@@ -96,7 +96,7 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
         photons: Some(a.photons),
         ..Overrides::default()
     };
-    let t = crate::trace(scene, &photons, &a.cache, a.threads, false)?;
+    let t = render::trace(scene, &photons, &a.cache, a.threads, false)?;
 
     // 3. The estimates.
     let variants = [
@@ -176,7 +176,7 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
     for v in &variants {
         let out = a.out.join(v.name);
         let reference_exr = ref_dir.join("image.exr");
-        let e = crate::render(
+        let e = render::render(
             scene,
             &RenderRequest {
                 overrides: Overrides {
@@ -194,7 +194,7 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
                 cache: &a.cache,
                 photons: Photons::CacheOnly,
                 threads: a.threads,
-                out: Some(out.clone()),
+                out: out.clone(),
                 exposure: 0.0,
                 reference: Some(&reference_exr),
                 label: Some(v.name.to_string()),
@@ -240,7 +240,7 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
     let mut caustic_rows = Vec::new();
     for (name, title, method, spp) in caustic_runs {
         let out = a.out.join(name);
-        let e = crate::render(
+        let e = render::render(
             scene,
             &RenderRequest {
                 overrides: Overrides {
@@ -253,7 +253,7 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
                 cache: &a.cache,
                 photons: Photons::TraceOrReuse,
                 threads: a.threads,
-                out: Some(out.clone()),
+                out: out.clone(),
                 exposure: 0.0,
                 reference: Some(&ref_dir.join("image.exr")),
                 label: Some(name.to_string()),
@@ -464,7 +464,7 @@ one final-gather bounce.";
 
 /// The caustic map's k from the scene's `[estimate.caustic]`.
 fn settings_caustic_k(scene: &Scene) -> usize {
-    crate::Settings::new(scene, &Overrides::default()).map_or(250, |s| s.estimate.caustic.k)
+    render::Settings::new(scene, &Overrides::default()).map_or(250, |s| s.estimate.caustic.k)
 }
 
 /// Pixels whose camera ray (through the pixel centre) lands on the floor (a diffuse surface

@@ -14,23 +14,13 @@ mod sppm;
 pub use sppm::start_radius;
 
 use crate::maps::Maps;
-use crate::photon_cache::{self, CacheKey};
 use crate::settings::Settings;
 use emit::Plan;
 use film::{Film, Image, Normalize};
+use photons::cache::{self as photon_cache, CacheKey};
 use scene::{Method, Scene};
 use std::path::Path;
 use store::MapKind;
-
-/// The light-path classes of the path tracer's layers (eye::Part), which every layer's
-/// `classes` are drawn from.
-pub const CLASSES: [&str; 5] = [
-    "emitted",
-    "direct",
-    "indirect",
-    "caustic",
-    "caustic_indirect",
-];
 
 /// Where a photon method gets its photon sets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -69,13 +59,13 @@ impl Run<'_> {
     }
 }
 
-/// One layer of an image: its name, the light-path classes ([`CLASSES`]) it estimates, its
+/// One layer of an image: its name, the light-path classes (`film::Class`) it estimates, its
 /// pixels (already divided by the sample count), and its weight when runs are composited:
 /// samples per pixel for layers the eye pass estimates alone, photon paths for layers made
 /// from photons.
 pub struct Layer {
     pub name: String,
-    pub classes: Vec<&'static str>,
+    pub classes: Vec<film::Class>,
     pub image: Image,
     pub count: u64,
     pub count_kind: CountKind,
@@ -219,7 +209,7 @@ pub fn work(run: &Run) -> u64 {
 }
 
 /// How one film layer is described: name, classes, count, count kind.
-pub(crate) type LayerSpec<'a> = (&'a str, &'a [&'static str], u64, CountKind);
+pub(crate) type LayerSpec<'a> = (&'a str, &'a [film::Class], u64, CountKind);
 
 /// The film's layers divided by `spp`, tagged with their classes and counts. A layer the film
 /// lacks is an error (an image silently missing light is worse than none).
@@ -311,7 +301,7 @@ pub(crate) fn photon_inputs<'a>(
     } else {
         vec![MapKind::Global]
     };
-    let maps = photon_cache::load_maps(run.cache, &key, &kinds)?;
+    let maps = crate::maps::load(run.cache, &key, &kinds)?;
     Ok(PhotonInputs {
         plan,
         maps: Maps {

@@ -5,6 +5,7 @@
 
 use super::{CountKind, Layer, Rendered, Run, Snapshot};
 use crate::splat;
+use film::Class;
 
 /// JSON facts for `image.json`.
 type Facts = serde_json::Map<String, serde_json::Value>;
@@ -58,9 +59,9 @@ impl<'a> Progressive<'a> {
     /// The layers' names, in the order [`Progressive::block`] returns their sums.
     pub(super) fn layer_names(&self) -> Vec<String> {
         let n = if self.images[1].is_empty() { 1 } else { 2 };
-        ["caustic", "caustic_indirect"][..n]
+        [Class::Caustic, Class::CausticIndirect][..n]
             .iter()
-            .map(|s| s.to_string())
+            .map(|c| c.name().to_string())
             .collect()
     }
 
@@ -119,20 +120,20 @@ impl<'a> Progressive<'a> {
 
     /// The layers so far, each the mean over the passes made.
     pub(super) fn layers(&self) -> Vec<Layer> {
-        let names: &[&'static str] = if self.images[1].is_empty() {
-            &["caustic"]
+        let classes: &[Class] = if self.images[1].is_empty() {
+            &[Class::Caustic]
         } else {
-            &["caustic", "caustic_indirect"]
+            &[Class::Caustic, Class::CausticIndirect]
         };
         let n = self.passes.max(1) as f64;
-        names
+        classes
             .iter()
             .zip(&self.images)
-            .map(|(&name, sums)| {
+            .map(|(&class, sums)| {
                 let pixels: Vec<glam::DVec3> = sums.iter().map(|v| *v / n).collect();
                 Layer {
-                    name: name.into(),
-                    classes: vec![name],
+                    name: class.name().into(),
+                    classes: vec![class],
                     image: splat::to_image(self.run.scene, &pixels),
                     count: self.passes as u64 * self.params.photons,
                     count_kind: CountKind::PhotonPaths,

@@ -1,40 +1,28 @@
-//! `pipeline`: the stages wired together as a library, so that everything a command does can
-//! be called (and tested) in one process. The binary `photonflow` parses flags, picks paths
-//! and calls [`render`] or [`trace`]; the end-to-end tests in `tests/` call the library the
-//! same way.
+//! `render`: the eye side of photonflow wired as a library, so that everything a command
+//! does can be called (and tested) in one process. The binary `photonflow` parses flags and
+//! calls [`render`] or [`trace`]; `lab` and the end-to-end tests call it the same way.
 //!
 //! - [`settings`]: the scene file's `[photons]` and `[estimate]` tables, typed, with the
 //!   command line's overrides; the resolved scene file every output directory holds.
-//! - [`flow`]: the channel pipeline (emission workers → bounded channel → chunks in index
-//!   order → [`flow::Sink`]s: the photon file writer, or any stage behind a channel).
-//! - [`photon_cache`]: cached photon sets keyed by what they depend on, traced on demand,
-//!   loaded as photon maps.
-//! - [`maps`], [`gather_cache`], [`boundary`]: the photon maps behind the eye pass, the
-//!   irradiance cache of final gathering, the boundary-bias correction.
-//! - [`methods`]: one file per method, one `match` on `scene::Method`.
-//! - [`output`]: a run's directory (EXR, PNG, layers, JSON, resolved scene).
-//! - [`worksheet`]: worksheet 7's report.
-//! - [`shard`]: a run split into shards by index ranges, and their exact merge.
-//!
-//! File IO happens only at paths the caller passes in.
+//! - [`methods`]: the method table (one row per method: what it reads, where `--spp` and
+//!   `--passes` go, how it shards) and one file per method; [`passes`]: the one progressive
+//!   pass loop.
+//! - [`maps`], [`gather_cache`], [`boundary`]: the photon maps behind the eye pass (loaded
+//!   from the `photons` cache), the irradiance cache of final gathering, the boundary-bias
+//!   correction.
+//! - [`splat`]: the splatting stage on the channel pipeline (the accumulation itself is
+//!   `density::splat`'s).
+//! - [`output`]: a run's directory (EXR, PNG, layers, `image.json`, resolved scene).
+//! - [`shard`]: image shards and `merge`.
 
-pub mod accuracy;
-pub mod bench;
 pub mod boundary;
-pub mod evidence;
-pub mod flow;
 pub mod gather_cache;
 pub mod maps;
 pub mod methods;
 pub mod output;
-pub mod photon_cache;
-pub mod plots;
-pub mod progress;
-pub mod report;
 pub mod settings;
 pub mod shard;
 pub mod splat;
-pub mod worksheet;
 
 #[cfg(test)]
 mod tests;
@@ -42,7 +30,7 @@ mod tests;
 pub use methods::{Photons, Rendered, Run};
 pub use settings::{EstimateSettings, Overrides, Settings};
 
-use progress::Progress;
+use flow::Progress;
 use scene::Scene;
 use std::path::{Path, PathBuf};
 
@@ -52,8 +40,8 @@ pub struct RenderRequest<'a> {
     pub cache: &'a Path,
     pub photons: Photons,
     pub threads: Option<usize>,
-    /// Output directory; `None`: [`output::default_out`] of the label.
-    pub out: Option<PathBuf>,
+    /// Output directory.
+    pub out: PathBuf,
     pub exposure: f32,
     pub reference: Option<&'a Path>,
     /// The output directory's method part (default: the method's name).
@@ -81,10 +69,7 @@ pub fn render(scene: &Scene, req: &RenderRequest) -> Result<RenderSummary, Strin
         threads: req.threads,
     };
     let label = req.label.clone().unwrap_or_else(|| settings.method.name());
-    let out = req
-        .out
-        .clone()
-        .unwrap_or_else(|| output::default_out(&scene.path, &label));
+    let out = req.out.clone();
     // Everything that can refuse the run is checked before the render starts.
     let reference = match req.reference {
         Some(p) => Some((p, read_reference(scene, p)?)),
@@ -164,10 +149,23 @@ pub fn trace(
     cache: &Path,
     threads: Option<usize>,
     force: bool,
-) -> Result<photon_cache::TraceOutput, String> {
+) -> Result<photons::TraceOutput, String> {
     let settings = Settings::new(scene, overrides)?;
     let threads = threads.unwrap_or_else(rayon::current_num_threads);
-    photon_cache::trace(scene, &settings.emit, cache, threads, force)
+    photons::trace(scene, &settings.emit, cache, threads, force)
+}
+
+/// `trace --shard I/N`: the shard's photon paths of the run `overrides` describe, into `out`.
+pub fn trace_shard(
+    scene: &Scene,
+    overrides: &Overrides,
+    shard: photons::shard::ShardId,
+    out: &Path,
+    threads: Option<usize>,
+) -> Result<photons::shard::Manifest, String> {
+    let settings = Settings::new(scene, overrides)?;
+    let threads = threads.unwrap_or_else(rayon::current_num_threads);
+    photons::shard::trace(scene, &settings.emit, shard, out, threads)
 }
 
 /// What a scene holds, for `photonflow info`: triangles, spheres, lights and their power,

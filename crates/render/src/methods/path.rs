@@ -10,7 +10,7 @@
 //! and records the samples made.
 
 use super::{CountKind, Layer, Rendered, Run, Snapshot};
-use eye::Part;
+use film::Class;
 use glam::DVec3;
 
 /// A pass holds at most this share of a run's samples.
@@ -20,7 +20,7 @@ const MIN_PASSES: u32 = 8;
 pub(super) struct Progressive<'a> {
     run: &'a Run<'a>,
     opts: eye::RenderOptions,
-    parts: Vec<Part>,
+    parts: Vec<Class>,
     sums: Vec<Vec<DVec3>>,
     /// Samples per pixel made so far.
     pub samples: u32,
@@ -43,7 +43,7 @@ impl<'a> Progressive<'a> {
         };
         // Each path-traced layer is one class; a layer the caustic switches empty is left
         // out, so a splatted layer can take its place.
-        let parts: Vec<Part> = Part::ALL
+        let parts: Vec<Class> = Class::ALL
             .into_iter()
             .filter(|&p| path_opts.estimates(p))
             .collect();
@@ -156,7 +156,7 @@ impl<'a> Progressive<'a> {
             .zip(&self.sums)
             .map(|(part, sums)| Layer {
                 name: part.name().to_string(),
-                classes: vec![super::CLASSES[*part as usize]],
+                classes: vec![*part],
                 image: film::Image::from_fn(w, h, |x, y| {
                     (sums[y * w + x] / n).as_vec3().to_array()
                 }),

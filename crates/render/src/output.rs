@@ -8,24 +8,7 @@ use crate::methods::Rendered;
 use crate::settings::Settings;
 use film::{Image, Mask, ToneMap};
 use scene::Scene;
-use std::path::{Path, PathBuf};
-
-/// Default output directory: `out/<scene dir>-<scene file stem>-<label>`.
-pub fn default_out(scene: &Path, label: &str) -> PathBuf {
-    let stem = scene
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "scene".into());
-    let parent = scene
-        .parent()
-        .and_then(|p| p.file_name())
-        .map(|s| s.to_string_lossy().into_owned());
-    let name = match parent {
-        Some(p) if !p.is_empty() => format!("{p}-{stem}"),
-        _ => stem,
-    };
-    PathBuf::from("out").join(format!("{name}-{label}"))
-}
+use std::path::Path;
 
 /// How to write a run.
 pub struct OutputOptions<'a> {
@@ -117,7 +100,7 @@ pub fn write(
         "seed": scene.seed(),
         "width": image.width,
         "height": image.height,
-        "layers": r.layers.iter().map(|l| (l.name.clone(), serde_json::json!(l.classes)))
+        "layers": r.layers.iter().map(|l| (l.name.clone(), serde_json::json!(l.classes.iter().map(|c| c.name()).collect::<Vec<_>>())))
             .collect::<serde_json::Map<_, _>>(),
         "layer_counts": r.layers.iter()
             .map(|l| (l.name.clone(), serde_json::json!({

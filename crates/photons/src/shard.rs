@@ -1,29 +1,22 @@
-//! Shards of one run and their merge (issue 14). Photon `i` draws from the stream `(seed, i)`
-//! and pixel sample `s` from its own, so a run split into index ranges can run anywhere and
-//! be put back together exactly:
+//! Shards of one run, the directories they live in, and the merge of photon shards. Photon `i`
+//! draws from the stream `(seed, i)` and pixel sample `s` from its own, so a run split into
+//! index ranges can run anywhere and be put back together exactly:
 //!
 //! - `trace --shard I/N` traces photon paths `[I P / N, (I + 1) P / N)` of a run of `P` (powers
 //!   already divided by `P`), into photon files whose header counts the shard's paths;
 //!   merging concatenates them in shard order and writes the photon file the one-machine
 //!   `trace` writes, byte for byte.
-//! - `render --shard I/N` (`path`, `caustic-splat`) renders the blocks of the run
-//!   ([`crate::methods::Accumulate`]: the path tracer's passes of samples, splatting's
-//!   passes) that start in the shard's range, and writes each block's f64 sums per pixel;
-//!   merging adds every block from zero in block order, exactly as the one-machine run adds
-//!   them, and writes the same `image.exr` and `layers/`.
-//!
-//! A shard is a directory: its results and `shard.json` ([`Manifest`]: scene hash, seed,
-//! parameter hash, shard `I/N`, range and counts). It is built under a temporary name and
-//! renamed into place, so a shard directory is complete or absent.
+//! - image shards (`render --shard I/N`) are `render`'s; they share the directory format:
+//!   a shard is a directory holding its results and `shard.json` ([`Manifest`]: scene hash,
+//!   seed, parameter hash, shard `I/N`, range and counts), built under a temporary name and
+//!   renamed into place, so a shard directory is complete or absent.
 
-use crate::flow::{self, PipelineOptions, Sink, StoreSink};
-use crate::methods::{self, Run};
-use crate::photon_cache::{self, CacheKey};
-use crate::progress::Progress;
-use crate::settings::{Overrides, Settings};
+use crate::cache::{self, CacheKey};
+use crate::sinks::StoreSink;
 pub use composite::shards::ShardId;
 use composite::shards::{Part, cover};
-use glam::DVec3;
+use emit::EmitParams;
+use flow::{PipelineOptions, Progress};
 use scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -31,9 +24,7 @@ use store::{Header, MapKind, MappedStore, StoreWriter};
 
 /// The file that describes a shard directory.
 pub const MANIFEST: &str = "shard.json";
-/// The f64 block sums of an image shard (`film::write_sums`), block by block, layer by layer.
-pub const SUMS: &str = "sums.f64";
-const VERSION: u32 = 1;
+pub const VERSION: u32 = 1;
 
 /// `shard.json`: what a shard holds and what it belongs to.
 #[derive(Serialize, Deserialize, Clone, Debug)]
@@ -75,25 +66,13 @@ pub struct Manifest {
     pub seconds: f64,
 }
 
-/// Where a shard goes without `--out`: `out/shards/<scene dir>-<stem>-<what>-<I>-of-<N>`.
-pub fn default_out(scene: &Path, what: &str, shard: ShardId) -> PathBuf {
-    let run = crate::output::default_out(scene, what);
-    let name = run.file_name().map(|n| n.to_string_lossy().into_owned());
-    PathBuf::from("out").join("shards").join(format!(
-        "{}-{}-of-{}",
-        name.unwrap_or_default(),
-        shard.index,
-        shard.count
-    ))
-}
-
-fn hex(v: u64) -> String {
+pub fn hex(v: u64) -> String {
     format!("{v:016x}")
 }
 
 /// A fresh temporary directory beside `out`, after refusing an `out` that is something
 /// other than a shard (a shard is replaced whole: a requeued task writes its shard again).
-fn start(out: &Path) -> Result<PathBuf, String> {
+pub fn start(out: &Path) -> Result<PathBuf, String> {
     if out.exists() && !out.join(MANIFEST).is_file() {
         let empty = std::fs::read_dir(out).is_ok_and(|mut d| d.next().is_none());
         if !empty {
@@ -122,7 +101,7 @@ fn start(out: &Path) -> Result<PathBuf, String> {
 
 /// Writes the manifest last into `tmp`, then renames `tmp` to `out` (an old shard there is
 /// moved aside first and removed after).
-fn publish(tmp: &Path, out: &Path, m: &Manifest) -> Result<(), String> {
+pub fn publish(tmp: &Path, out: &Path, m: &Manifest) -> Result<(), String> {
     let text = serde_json::to_string_pretty(m).map_err(|e| e.to_string())? + "\n";
     film::write_atomic(&tmp.join(MANIFEST), text.as_bytes()).map_err(|e| e.to_string())?;
     let old = tmp.with_extension("old");
@@ -136,22 +115,20 @@ fn publish(tmp: &Path, out: &Path, m: &Manifest) -> Result<(), String> {
     Ok(())
 }
 
-/// `trace --shard I/N`: traces the shard's photon paths of the run `overrides` describe into
-/// `out` (a shard directory).
+/// `trace --shard I/N`: traces the shard's photon paths of a run of `params` into `out` (a
+/// shard directory).
 pub fn trace(
     scene: &Scene,
-    overrides: &Overrides,
+    params: &EmitParams,
     shard: ShardId,
     out: &Path,
-    threads: Option<usize>,
+    threads: usize,
 ) -> Result<Manifest, String> {
-    let settings = Settings::new(scene, overrides)?;
-    let params = &settings.emit;
-    let threads = threads.unwrap_or_else(rayon::current_num_threads).max(1);
+    let threads = threads.max(1);
     let plan = emit::Plan::for_scene(scene, params)
         .map_err(|e| format!("{}: {e}", scene.path.display()))?;
     let key = CacheKey::new(scene, params);
-    let kinds = photon_cache::planned_kinds(&plan);
+    let kinds = cache::planned_kinds(&plan);
     let range = shard.range(params.photons);
     let tmp = start(out)?;
     let files: Vec<(MapKind, PathBuf)> = kinds
@@ -168,7 +145,7 @@ pub fn trace(
         &|r| emit::trace_range(scene, params, &plan, a + r.start..a + r.end),
         &mut |traced| {
             let traced = std::sync::Arc::new(traced);
-            store.consume(&traced)?;
+            flow::Sink::consume(&mut store, &traced)?;
             progress.inc(traced.emitted);
             Ok(())
         },
@@ -202,85 +179,14 @@ pub fn trace(
     Ok(m)
 }
 
-/// `render --shard I/N`: renders the shard's blocks of the run `run` describes into `out`.
-pub fn render(run: &Run, shard: ShardId, out: &Path) -> Result<Manifest, String> {
-    let (scene, settings) = (run.scene, run.settings);
-    let method = settings.method;
-    let blocks_fn = methods::spec(method)
-        .blocks
-        .map_err(|why| format!("--shard cannot split `{method}`: {why}"))?;
-    if settings.time.is_some() {
-        return Err(
-            "--shard with --time: a time budget makes the work depend on the machine; give \
-             the full budget (--spp or --passes) instead"
-                .into(),
-        );
-    }
-    let resolved = settings.resolved_scene(scene)?;
-    let scene_text = toml::to_string(&resolved).map_err(|e| {
-        format!(
-            "{}: the resolved scene does not serialise: {e}",
-            scene.path.display()
-        )
-    })?;
-    let mut b = blocks_fn(run);
-    let total = b.blocks.len() as u64;
-    let mine = shard.blocks(&b.blocks, b.blocks.last().map_or(0, |r| r.end));
-    let layers = b.acc.layer_names();
-    let tmp = start(out)?;
-    let t0 = std::time::Instant::now();
-    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-    let mut planes = Vec::new();
-    let mut count = 0;
-    let work: u64 = b.blocks[mine.clone()].iter().map(|r| r.end - r.start).sum();
-    let progress = Progress::new(&format!("{method} shard {shard}"), work, b.unit);
-    for r in &b.blocks[mine.clone()] {
-        let sums = b.acc.block(r.clone(), &|n| progress.inc(n))?;
-        count += r.end - r.start;
-        planes.extend(
-            sums.into_iter()
-                .map(|p| p.into_iter().map(|v| v.to_array()).collect::<Vec<_>>()),
-        );
-    }
-    progress.finish();
-    let sums = film::Sums {
-        width: w,
-        height: h,
-        planes,
-    };
-    film::write_sums(&tmp.join(SUMS), &sums).map_err(|e| e.to_string())?;
-    film::write_atomic(&tmp.join("scene.toml"), scene_text.as_bytes())
-        .map_err(|e| e.to_string())?;
-    let m = Manifest {
-        photonflow_shard: VERSION,
-        what: "image".into(),
-        method: Some(method.name()),
-        scene: scene.path.display().to_string(),
-        scene_hash: hex(scene.view_hash),
-        seed: scene.seed(),
-        params_hash: hex(settings.hash(scene)),
-        shard: shard.to_string(),
-        unit: b.unit.into(),
-        range: [mine.start as u64, mine.end as u64],
-        total,
-        blocks: b.blocks.iter().map(|r| [r.start, r.end]).collect(),
-        layers,
-        sets: Vec::new(),
-        count,
-        seconds: t0.elapsed().as_secs_f64(),
-    };
-    publish(&tmp, out, &m)?;
-    Ok(m)
-}
-
 /// A shard directory given to `merge`, read and checked on its own.
-struct Input {
-    dir: PathBuf,
-    m: Manifest,
-    shard: ShardId,
+pub struct Input {
+    pub dir: PathBuf,
+    pub m: Manifest,
+    pub shard: ShardId,
 }
 
-fn read_input(p: &Path) -> Result<Input, String> {
+pub fn read_input(p: &Path) -> Result<Input, String> {
     let dir = if p.file_name().is_some_and(|n| n == MANIFEST) {
         p.parent().unwrap_or(Path::new(".")).to_path_buf()
     } else {
@@ -320,13 +226,13 @@ fn read_input(p: &Path) -> Result<Input, String> {
     Ok(Input { dir, m, shard })
 }
 
-/// `merge`: the shards `inputs` put back together into `out`: photon sets into `out` as a
-/// cache directory, images into `out` as a run directory. Everything is read and checked
-/// before anything is written.
-pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<String, String> {
-    let Some(first) = inputs.first() else {
+/// The shard directories `inputs`, each read and checked, and checked to be parts of one run
+/// (what they hold, method, seed, scene and parameters), with `out` not among them; and the
+/// parts they cover, for `composite::shards::cover`.
+pub fn read_all(inputs: &[PathBuf], out: &Path) -> Result<(Vec<Input>, Vec<Part>), String> {
+    if inputs.is_empty() {
         return Err("merge: no inputs given".into());
-    };
+    }
     let mut all = Vec::with_capacity(inputs.len());
     for p in inputs {
         all.push(read_input(p)?);
@@ -382,30 +288,17 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<String, String> {
             range: i.m.range[0]..i.m.range[1],
         })
         .collect();
-    match a.m.what.as_str() {
-        "photons" => {
-            let total = a.m.total;
-            let order = cover(&parts, total, &|s| s.range(total))?;
-            merge_photons(&all, &order, out)
-        }
-        "image" => {
-            let blocks: Vec<std::ops::Range<u64>> = a.m.blocks.iter().map(|b| b[0]..b[1]).collect();
-            let end = blocks.last().map_or(0, |r| r.end);
-            let expect = |s: ShardId| {
-                let r = s.blocks(&blocks, end);
-                r.start as u64..r.end as u64
-            };
-            let order = cover(&parts, a.m.total, &expect)?;
-            merge_image(&all, &order, out)
-        }
-        other => Err(format!(
-            "{}: holds `{other}`, neither photons nor an image",
-            first.display()
-        )),
-    }
+    Ok((all, parts))
 }
 
-fn same_dir(a: &Path, b: &Path) -> bool {
+/// Merges photon shards (`read_all`'s) into `out` as a cache directory.
+pub fn merge_photons(all: &[Input], parts: &[Part], out: &Path) -> Result<String, String> {
+    let total = all.first().map_or(0, |a| a.m.total);
+    let order = cover(parts, total, &|s| s.range(total))?;
+    merge_photon_files(all, &order, out)
+}
+
+pub fn same_dir(a: &Path, b: &Path) -> bool {
     match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
         (Ok(x), Ok(y)) => x == y,
         _ => false,
@@ -416,7 +309,7 @@ fn parse_hex(s: &str, file: &Path) -> Result<u64, String> {
     u64::from_str_radix(s, 16).map_err(|_| format!("{}: `{s}` is not a hash", file.display()))
 }
 
-fn merge_photons(all: &[Input], order: &[usize], out: &Path) -> Result<String, String> {
+fn merge_photon_files(all: &[Input], order: &[usize], out: &Path) -> Result<String, String> {
     let a = &all[0];
     let m0 = a.dir.join(MANIFEST);
     let (scene_hash, params_hash) = (
@@ -510,101 +403,5 @@ fn merge_photons(all: &[Input], order: &[usize], out: &Path) -> Result<String, S
         order.len(),
         a.m.total,
         written.join(", ")
-    ))
-}
-
-fn merge_image(all: &[Input], order: &[usize], out: &Path) -> Result<String, String> {
-    let a = &all[0];
-    let scene_file = a.dir.join("scene.toml");
-    // The shard's resolved scene: its settings are the run's, flags and all.
-    let scene = Scene::load(&scene_file).map_err(|e| e.to_string())?;
-    let settings = Settings::new(&scene, &Overrides::default())?;
-    let m0 = a.dir.join(MANIFEST);
-    if hex(scene.view_hash) != a.m.scene_hash
-        || scene.seed() != a.m.seed
-        || hex(settings.hash(&scene)) != a.m.params_hash
-    {
-        return Err(format!(
-            "{}: the scene (or a file it names) changed since {} was rendered",
-            scene_file.display(),
-            m0.display()
-        ));
-    }
-    let run = Run {
-        scene: &scene,
-        settings: &settings,
-        cache: Path::new("."),
-        photons: methods::Photons::CacheOnly,
-        threads: Some(1),
-    };
-    let blocks_fn = methods::spec(settings.method)
-        .blocks
-        .map_err(|why| format!("{}: {why}", m0.display()))?;
-    let mut b = blocks_fn(&run);
-    let blocks: Vec<[u64; 2]> = b.blocks.iter().map(|r| [r.start, r.end]).collect();
-    if blocks != a.m.blocks || b.acc.layer_names() != a.m.layers {
-        return Err(format!(
-            "{}: its blocks or layers are not those this photonflow renders for its scene",
-            m0.display()
-        ));
-    }
-    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-    let nl = a.m.layers.len();
-    // Read and check every shard's sums before any output; added one shard at a time.
-    let mut sums = Vec::with_capacity(order.len());
-    for &i in order {
-        let inp = &all[i];
-        let path = inp.dir.join(SUMS);
-        let s = film::read_sums(&path).map_err(|e| e.to_string())?;
-        let nb = (inp.m.range[1] - inp.m.range[0]) as usize;
-        if (s.width, s.height, s.planes.len()) != (w, h, nb * nl) {
-            return Err(format!(
-                "{}: {}x{} in {} planes, but the shard's {nb} blocks of {nl} layers of the \
-                 {w}x{h} view need {}",
-                path.display(),
-                s.width,
-                s.height,
-                s.planes.len(),
-                nb * nl
-            ));
-        }
-        sums.push(s);
-    }
-    let mut seconds = 0.0;
-    for (&i, s) in order.iter().zip(sums) {
-        let inp = &all[i];
-        seconds += inp.m.seconds;
-        let first = inp.m.range[0] as usize;
-        let mut planes = s.planes.into_iter();
-        for r in &b.blocks[first..inp.m.range[1] as usize] {
-            let block: Vec<Vec<DVec3>> = planes
-                .by_ref()
-                .take(nl)
-                .map(|p| p.into_iter().map(DVec3::from_array).collect())
-                .collect();
-            b.acc.add(&block, r.end - r.start);
-        }
-    }
-    let rendered = b.acc.finish(seconds);
-    let label = settings.method.name();
-    crate::output::write(
-        &scene,
-        &settings,
-        &rendered,
-        &crate::output::OutputOptions {
-            out,
-            exposure: 0.0,
-            reference: None,
-            label: &label,
-            threads: 0,
-            seconds,
-        },
-    )?;
-    Ok(format!(
-        "merged {} shards of {label} ({} {}) into {}/image.{{exr,png,json}}, layers/, scene.toml",
-        order.len(),
-        b.blocks.last().map_or(0, |r| r.end),
-        a.m.unit,
-        out.display()
     ))
 }

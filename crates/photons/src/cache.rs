@@ -1,14 +1,13 @@
-//! The photon stage and its cache: plans the sets a scene needs, reuses them when an
-//! identical run made them, else traces them through the channel pipeline into photon files,
-//! and loads them back as photon maps.
+//! The photon cache: plans the sets a scene needs, reuses them when an identical run made
+//! them, else traces them through the channel pipeline into photon files; opens them again,
+//! checked against their key, for whatever reads them.
 
-use crate::flow::{self, PipelineOptions, Sink, StoreSink};
-use crate::progress::Progress;
-use density::{IndexKind, PhotonMap};
+use crate::sinks::{self, Sink, StoreSink};
 use emit::{EmitParams, Plan};
+use flow::{PipelineOptions, Progress};
 use scene::Scene;
 use std::path::{Path, PathBuf};
-use store::{Expect, Header, MapKind, MappedStore, PerKind};
+use store::{Expect, Header, MapKind, MappedStore};
 
 /// Bump when `emit` changes which photons it stores or what they carry.
 pub const PHOTON_TRACER_VERSION: u32 = 1;
@@ -161,7 +160,7 @@ pub fn trace(
     write_plan()?;
     let progress = Progress::new("trace", params.photons, "photons");
     let mut store = StoreSink::create(&files, &|k| key.header(scene, k))?;
-    let stats = flow::run(
+    let stats = sinks::run(
         scene,
         params,
         &plan,
@@ -179,9 +178,9 @@ pub fn trace(
     let all: u64 = stored.iter().map(|(_, n)| n).sum();
     println!(
         "traced {} photon paths in {:.2} s ({:.3} M paths/s on {threads} threads, at most {} chunks in memory); stored {} global, {} caustic ({:.1} bytes/photon)",
-        stats.emitted,
+        stats.total,
         stats.seconds,
-        stats.emitted as f64 / stats.seconds / 1e6,
+        stats.total as f64 / stats.seconds / 1e6,
         stats.max_in_flight,
         stored[MapKind::Global],
         stored[MapKind::Caustic],
@@ -230,43 +229,17 @@ fn check_space(scene: &Scene, params: &EmitParams, plan: &Plan, dir: &Path) -> R
     ))
 }
 
-/// Most photons one map may hold: the kd-tree indexes with u32.
-pub const MAX_MAP_PHOTONS: u64 = u32::MAX as u64 - 1;
-
-/// Loads the sets `kinds` of `key` from `dir` as photon maps (never traces: a missing set is
-/// an error that says to run `trace`).
-pub fn load_maps(
-    dir: &Path,
-    key: &CacheKey,
-    kinds: &[MapKind],
-) -> Result<PerKind<Option<PhotonMap>>, String> {
-    let mut maps: PerKind<Option<PhotonMap>> = PerKind::default();
-    for &kind in kinds {
-        let path = key.file(dir, kind);
-        if !path.exists() {
-            return Err(format!(
-                "{}: no cached photon set for this scene and these parameters; run `trace` first",
-                path.display()
-            ));
-        }
-        let store = MappedStore::open(&path).map_err(|e| e.to_string())?;
-        store.check(&key.expect(kind)).map_err(|e| e.to_string())?;
-        if store.header().stored > MAX_MAP_PHOTONS {
-            return Err(format!(
-                "{}: {} photons exceed the {MAX_MAP_PHOTONS} one map can index",
-                path.display(),
-                store.header().stored
-            ));
-        }
-        if store.header().stored == 0 && kind == MapKind::Global {
-            eprintln!(
-                "warning: {}: the global photon set is empty",
-                path.display()
-            );
-        }
-        // Photon powers from `emit` already carry the 1/N of the emitted count the header
-        // records (the photon-power invariant), so the map sums them as they are.
-        maps[kind] = Some(PhotonMap::build(store.to_vec(), IndexKind::KdTree));
+/// Opens the cached set `kind` of `key` in `dir`, every chunk's checksum and the header's key
+/// checked (never traces: a missing set is an error that says to run `trace`).
+pub fn open(dir: &Path, key: &CacheKey, kind: MapKind) -> Result<MappedStore, String> {
+    let path = key.file(dir, kind);
+    if !path.exists() {
+        return Err(format!(
+            "{}: no cached photon set for this scene and these parameters; run `trace` first",
+            path.display()
+        ));
     }
-    Ok(maps)
+    let store = MappedStore::open(&path).map_err(|e| e.to_string())?;
+    store.check(&key.expect(kind)).map_err(|e| e.to_string())?;
+    Ok(store)
 }

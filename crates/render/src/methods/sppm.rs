@@ -14,10 +14,11 @@
 //! goes to zero (consistent), unlike a fixed k or radius.
 
 use super::{CountKind, Layer, Rendered, Run, Snapshot};
-use crate::flow::{self, PipelineOptions};
 use crate::settings::SppmSettings;
 use density::{IndexKind, PhotonMap};
 use emit::{EmitParams, Plan};
+use film::Class;
+use flow::PipelineOptions;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use scene::Scene;
@@ -249,9 +250,9 @@ fn layers(
         Layer {
             name: "light".into(),
             classes: if direct {
-                vec!["emitted", "direct"]
+                vec![Class::Emitted, Class::Direct]
             } else {
-                vec!["emitted"]
+                vec![Class::Emitted]
             },
             image: light,
             count: passes as u64,
@@ -260,9 +261,14 @@ fn layers(
         Layer {
             name: "photons".into(),
             classes: if direct {
-                vec!["indirect", "caustic", "caustic_indirect"]
+                vec![Class::Indirect, Class::Caustic, Class::CausticIndirect]
             } else {
-                vec!["direct", "indirect", "caustic", "caustic_indirect"]
+                vec![
+                    Class::Direct,
+                    Class::Indirect,
+                    Class::Caustic,
+                    Class::CausticIndirect,
+                ]
             },
             image: photons,
             count: passes as u64 * per_pass,

@@ -1,0 +1,27 @@
+//! `lab`: the studies built on `render`, which `render` never imports. Worksheet 7's report
+//! ([`worksheet`]), the evidence ladders ([`evidence`]) and their lab report ([`report`],
+//! [`plots`]), the accuracy benchmark's driver ([`accuracy`]) and the speed benchmarks'
+//! ([`bench`]), the regions of an image drawn from the scene's geometry ([`regions`]), and the
+//! one cached path-traced reference they share ([`reference`]).
+
+pub mod accuracy;
+pub mod bench;
+pub mod evidence;
+pub mod plots;
+pub mod report;
+pub mod worksheet;
+
+#[cfg(test)]
+mod tests;
+
+/// `evidence`: the ladders measured ([`evidence::run`]), then the lab report written beside
+/// them ([`report::write`]).
+pub fn evidence(a: &evidence::EvidenceArgs) -> Result<(), String> {
+    let m = evidence::run(a)?;
+    report::write(&a.out, &m.evidence, &m.scene, &m.regions)?;
+    println!(
+        "wrote {} and report.html, evidence.md (tables), evidence.json, maps/, plots/",
+        a.out.join("report.md").display()
+    );
+    Ok(())
+}

@@ -1,0 +1,208 @@
+//! Unit tests of the photon maps' helpers: the boundary correction's kernel mass, the
+//! irradiance cache of final gathering.
+
+use emit::{EmitParams, Plan};
+use std::path::{Path, PathBuf};
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("photonflow-render-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn cornell() -> scene::Scene {
+    let p =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-spheres/analytic.toml");
+    scene::Scene::load(p).unwrap()
+}
+
+#[test]
+fn kernel_mass_on_surface_is_one_inside_and_drops_at_edges_and_corners() {
+    use crate::boundary::kernel_mass_on_surface;
+    use density::{EstimateParams, Kernel};
+    use glam::Vec3;
+    let s = cornell();
+    let with = |kernel| EstimateParams {
+        kernel,
+        topo: Some(0.1),
+        ..EstimateParams::default()
+    };
+    // Floor centre, away from the spheres' footprints: the whole disc is floor.
+    let centre = Vec3::new(-7.0, 0.0, -2.0);
+    let m = kernel_mass_on_surface(&s, centre, Vec3::Y, 0.5, &with(Kernel::Uniform));
+    assert_eq!(m, 1.0);
+    // At the back wall (z = -13.98), the floor disc is cut in half.
+    let edge = Vec3::new(-7.0, 0.0, -13.98);
+    let m = kernel_mass_on_surface(&s, edge, Vec3::Y, 0.5, &with(Kernel::Uniform));
+    assert!((m - 0.5).abs() < 0.07, "{m}");
+    // In the floor's corner with the right wall (x = 0): a quarter.
+    let corner = Vec3::new(0.0, 0.0, -13.98);
+    let m = kernel_mass_on_surface(&s, corner, Vec3::Y, 0.5, &with(Kernel::Uniform));
+    assert!((m - 0.25).abs() < 0.07, "{m}");
+    // Past the open front (z = 0) the floor ends too.
+    let front = Vec3::new(-7.0, 0.0, 0.0);
+    let m = kernel_mass_on_surface(&s, front, Vec3::Y, 0.5, &with(Kernel::Silverman));
+    assert!((m - 0.5).abs() < 0.07, "{m}");
+}
+
+#[test]
+fn the_gather_cache_answers_like_the_map_it_summarises() {
+    use crate::gather_cache::IrradianceCache;
+    use density::{EstimateParams, IndexKind, PhotonMap};
+    use glam::Vec3;
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/corner/corner.toml");
+    let scene = scene::Scene::load(p).unwrap();
+    let params = EmitParams {
+        photons: 40_000,
+        ..EmitParams::default()
+    };
+    let plan = Plan::for_scene(&scene, &params).unwrap();
+    let traced = emit::trace_range(&scene, &params, &plan, 0..params.photons);
+    let map = PhotonMap::build(traced.sets.0[0].clone(), IndexKind::KdTree);
+    let est = EstimateParams {
+        k: 100,
+        ..EstimateParams::default()
+    };
+    let estimate = |x: Vec3, n: Vec3, h: &mut density::KnnHint, s: &mut Vec<density::Neighbor>| {
+        (map.irradiance_hinted(x, n, &est, h, s), h.r)
+    };
+    let cache = IrradianceCache::build(&scene, Some(&map), 4, &estimate);
+    assert!(
+        cache.len() > map.len() / 5,
+        "{} of {}",
+        cache.len(),
+        map.len()
+    );
+    // Point by point on the floor (normal +y) away from the wall, the cached answer is a
+    // neighbouring point's estimate: two k-NN estimates each with relative noise ~1/sqrt(k),
+    // so they differ by less than 4 sqrt(2) / sqrt(k) (57% at k = 100) point by point, and
+    // by less than 2% in the mean over 2000 points.
+    let per_point = 4.0 * 2f64.sqrt() / (est.k as f64).sqrt();
+    let mut rng = math::Rng::new(3);
+    let (mut exact, mut cached) = (0.0f64, 0.0f64);
+    let mut scratch = Vec::new();
+    for _ in 0..2000 {
+        let x = Vec3::new(0.5 + 3.0 * rng.uniform(), 0.0, -1.5 + 3.0 * rng.uniform());
+        let e = map.irradiance(x, Vec3::Y, &est, &mut scratch).x as f64;
+        let c = cache
+            .lookup(x, Vec3::Y)
+            .expect("a floor point near every floor query")
+            .x as f64;
+        assert!(
+            (c / e - 1.0).abs() < per_point,
+            "cached {c} vs {e} at {x:?}"
+        );
+        exact += e;
+        cached += c;
+    }
+    assert!(
+        (cached / exact - 1.0).abs() < 0.02,
+        "cached {cached} vs exact {exact}"
+    );
+    // On the wall (normal +x) the cache answers from wall points: their value tracks the
+    // wall's own estimate, not the floor's.
+    for y in [0.5f32, 1.0, 2.0] {
+        let x = Vec3::new(0.0, y, 0.3);
+        let e = map.irradiance(x, Vec3::X, &est, &mut scratch).x;
+        let c = cache
+            .lookup(x, Vec3::X)
+            .expect("wall points near the wall query")
+            .x;
+        assert!(
+            (c / e - 1.0).abs() < per_point as f32,
+            "wall: cached {c} vs {e}"
+        );
+    }
+    // Far from every photon (outside the scene) nothing answers.
+    assert!(cache.lookup(Vec3::new(50.0, 0.0, 0.0), Vec3::Y).is_none());
+}
+
+#[test]
+fn boundary_correction_removes_the_darkening_at_an_edge_and_a_corner() {
+    // A 4 x 4 floor with photons of uniform density (irradiance E0 = 1) and nothing beyond
+    // it: plain estimates near the edge see half a disc of photons (a quarter in the corner),
+    // corrected ones divide by the kernel mass on the floor and recover E0.
+    use crate::boundary::kernel_mass_on_surface;
+    use density::{EstimateParams, IndexKind, Kernel, KnnHint, PhotonMap};
+    use glam::Vec3;
+    let dir = scratch("edge");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("f.obj"),
+        "mtllib f.mtl\no floor\nusemtl white\nv 0 0 0\nv 0 0 4\nv 4 0 4\nv 4 0 0\nf 1 2 3\nf 1 3 4\n\
+         o light\nusemtl light\nv 1 3 1\nv 3 3 1\nv 3 3 3\nv 1 3 3\nf 5 6 7\nf 5 7 8\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("f.mtl"),
+        "newmtl white\nKd 0.5 0.5 0.5\nnewmtl light\nKe 1 1 1\n",
+    )
+    .unwrap();
+    let text = "[camera]\neye = [2, 5, 2.01]\nlook_at = [2, 0, 2]\nvfov = 60\nwidth = 8\nheight = 8\n\
+                [[mesh]]\nobj = \"f.obj\"\n";
+    let scene = scene::Scene::from_toml(&dir.join("s.toml"), text).unwrap();
+    let mut rng = math::Rng::new(17);
+    let n = 800_000;
+    let power = 16.0 / n as f32; // total flux 16 over area 16: E0 = 1
+    let photons: Vec<store::Photon> = (0..n)
+        .map(|_| {
+            let p = Vec3::new(4.0 * rng.uniform(), 0.0, 4.0 * rng.uniform());
+            store::Photon::new(p, Vec3::splat(power), -Vec3::Y, 0)
+        })
+        .collect();
+    let map = PhotonMap::build(photons, IndexKind::KdTree);
+    // Edge points: 20 along each of the 4 edges, a disc radius (~0.08) or more apart, so the
+    // estimates are nearly independent; corner points: the 4 corners. One k = 1000 estimate
+    // has relative noise ~1.5/sqrt(1000) = 5%: the means then carry ~0.8% (edges) and ~2.4%
+    // (corners), and 0.08 is more than 3 standard errors of either.
+    let edges: Vec<Vec3> = (0..80)
+        .map(|i| {
+            let t = 0.5 + 3.0 * (i % 20) as f32 / 19.0;
+            [
+                Vec3::new(t, 0.0, 0.0),
+                Vec3::new(t, 0.0, 4.0),
+                Vec3::new(0.0, 0.0, t),
+                Vec3::new(4.0, 0.0, t),
+            ][i / 20]
+        })
+        .collect();
+    let corners = vec![
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(4.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 4.0),
+        Vec3::new(4.0, 0.0, 4.0),
+    ];
+    for kernel in [Kernel::Uniform, Kernel::Silverman] {
+        let est = EstimateParams {
+            k: 1000,
+            kernel,
+            topo: Some(0.1),
+            drop_kth: true,
+            ..Default::default()
+        };
+        for (name, points, plain_expect) in [("edge", &edges, 0.5), ("corner", &corners, 0.25)] {
+            let (mut plain, mut corrected) = (0.0f64, 0.0f64);
+            let mut scratch = Vec::new();
+            for &x in points.iter() {
+                let mut hint = KnnHint::NONE;
+                let e = map
+                    .irradiance_hinted(x, Vec3::Y, &est, &mut hint, &mut scratch)
+                    .x;
+                let m = kernel_mass_on_surface(&scene, x, Vec3::Y, hint.r, &est);
+                plain += e as f64;
+                corrected += (e / m) as f64;
+            }
+            let q = points.len() as f64;
+            let (plain, corrected) = (plain / q, corrected / q);
+            assert!(
+                (plain - plain_expect).abs() < 0.08 * plain_expect * 2.0,
+                "{kernel:?} {name}: plain {plain}"
+            );
+            assert!(
+                (corrected - 1.0).abs() < 0.08,
+                "{kernel:?} {name}: corrected {corrected}"
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
