@@ -28,6 +28,8 @@
 
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
+use std::fmt;
+use std::str::FromStr;
 
 /// Jensen's Gaussian constants (Jensen 2001, §7.2, after Pavicic 1990).
 pub const JENSEN_ALPHA: f64 = 0.918;
@@ -101,6 +103,51 @@ impl Kernel {
     /// K(t): the normalised kernel (for one-off use; estimators hoist `norm`).
     pub fn weight(self, t: f64) -> f64 {
         self.shape(t) * self.norm()
+    }
+}
+
+/// The serde `kind` tag (what scene and parameter files spell), and `cone:K` for a cone of
+/// slope K != 1: one spelling for files and command lines. [`FromStr`] reads it back.
+impl fmt::Display for Kernel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match *self {
+            Kernel::Uniform => "uniform",
+            Kernel::Cone { k } if k != 1.0 => return write!(f, "cone:{k}"),
+            Kernel::Cone { .. } => "cone",
+            Kernel::Gaussian => "gaussian",
+            Kernel::GaussianJensen => "gaussian_jensen",
+            Kernel::Epanechnikov => "epanechnikov",
+            Kernel::Silverman => "silverman",
+            Kernel::Triweight => "triweight",
+        })
+    }
+}
+
+/// What [`Kernel`]'s `Display` writes, plus the input-only aliases `box` (uniform) and
+/// `simpson` (silverman); `cone:K` needs a finite K >= 1.
+impl FromStr for Kernel {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Kernel, String> {
+        let name = match s {
+            "box" => "uniform",
+            "simpson" => "silverman",
+            s => s,
+        };
+        // The names come from `Display` alone, so they are spelled once.
+        if let Some(k) = Kernel::ALL.into_iter().find(|k| k.to_string() == name) {
+            return Ok(k);
+        }
+        match name.strip_prefix("cone:").map(str::parse::<f32>) {
+            Some(Ok(k)) if k >= 1.0 && k.is_finite() => Ok(Kernel::Cone { k }),
+            _ => {
+                let names: Vec<String> = Kernel::ALL.iter().map(Kernel::to_string).collect();
+                Err(format!(
+                    "unknown kernel `{s}` ({}, cone:K with K >= 1; aliases box, simpson)",
+                    names.join(", ")
+                ))
+            }
+        }
     }
 }
 

@@ -3,7 +3,9 @@
 //! "Density Estimation"; Jensen 2001, "Realistic Image Synthesis Using Photon Mapping"
 //! §7.2), and the bias controls of worksheet 7 (same-side and topological tests, Garcia et
 //! al. 2012's k-th photon exclusion). No file IO: photons come in as values, their power
-//! already divided by the number of light paths emitted.
+//! already divided by the number of light paths emitted. Also as pure functions: photon
+//! splatting onto eye vertices (`splat`) and the per-pixel statistics of stochastic
+//! progressive photon mapping (`sppm`).
 //!
 //! Key decision: **every index returns exactly the same neighbours** — the k smallest
 //! `(d2, index)` within `r_max`, ties broken by index; for a fixed radius, every point
@@ -41,6 +43,7 @@ mod estimate;
 mod index;
 mod kernel;
 pub mod splat;
+pub mod sppm;
 
 pub use estimate::{EstimateParams, MapPhoton, PhotonMap, radiance_lambertian};
 pub use index::{Brute, Index, IndexKind, KdTree, Kiddo, KnnHint, Neighbor};

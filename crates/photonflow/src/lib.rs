@@ -505,7 +505,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
             photon,
             image,
         } => {
-            let reads_maps = |m: Method| render::methods::spec(m).photon_maps;
+            let reads_maps = |m: Method| render::methods::row(m).reads_photon_maps();
             if let Some(m) = method
                 && !reads_maps(m)
             {

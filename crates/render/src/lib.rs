@@ -20,6 +20,7 @@ pub mod gather_cache;
 pub mod maps;
 pub mod methods;
 pub mod output;
+pub mod passes;
 pub mod settings;
 pub mod shard;
 pub mod splat;
@@ -81,11 +82,10 @@ pub fn render(scene: &Scene, req: &RenderRequest) -> Result<RenderSummary, Strin
     // The bar starts with the eye pass's first finished tile, so tracing and loading photons
     // (which report on their own) neither share the terminal line nor its rate.
     let bar = std::sync::OnceLock::new();
-    let work = methods::work(&run);
+    let (work, unit) = methods::work(&run);
     let name = settings.method.name();
     let rendered = methods::render(&run, &|n| {
-        bar.get_or_init(|| Progress::new(&name, work, "samples"))
-            .inc(n)
+        bar.get_or_init(|| Progress::new(&name, work, unit)).inc(n)
     })?;
     if let Some(p) = bar.into_inner() {
         p.finish();

@@ -42,17 +42,7 @@ pub fn write(
         None => None,
     };
     // A run stopped by a time budget is reproduced by the passes it made.
-    let mut settings = settings.clone();
-    if let Some(p) = r.passes {
-        match settings.method {
-            scene::Method::Sppm => settings.estimate.sppm.passes = p,
-            _ => settings.estimate.splat.passes = p,
-        }
-    }
-    if let Some(n) = r.samples {
-        settings.render.spp = n;
-    }
-    let settings = &settings;
+    let settings = &settings.with_made(r);
     let resolved = settings.resolved_scene(scene)?;
     let scene_text = toml::to_string(&resolved).map_err(|e| {
         format!(

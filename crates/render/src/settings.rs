@@ -188,9 +188,70 @@ pub struct Settings {
     pub estimate: EstimateSettings,
 }
 
+/// A setting that a method-dependent flag sets: where `--spp` and `--passes` go, and where the
+/// passes a run made are recorded (the method table, `crate::methods::METHODS`, says which).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Knob {
+    /// `[render] spp`: the path tracer's samples per pixel.
+    RenderSpp,
+    /// `[estimate] spp`: samples per pixel of the photon methods' eye passes.
+    EstimateSpp,
+    /// `[estimate.splat] passes`.
+    SplatPasses,
+    /// `[estimate.sppm] passes`.
+    SppmPasses,
+}
+
+impl Knob {
+    /// The scene-file key, for messages.
+    pub const fn key(self) -> &'static str {
+        match self {
+            Knob::RenderSpp => "render.spp",
+            Knob::EstimateSpp => "estimate.spp",
+            Knob::SplatPasses => "estimate.splat.passes",
+            Knob::SppmPasses => "estimate.sppm.passes",
+        }
+    }
+
+    pub fn get(self, s: &Settings) -> u32 {
+        match self {
+            Knob::RenderSpp => s.render.spp,
+            Knob::EstimateSpp => s.estimate.spp,
+            Knob::SplatPasses => s.estimate.splat.passes,
+            Knob::SppmPasses => s.estimate.sppm.passes,
+        }
+    }
+
+    pub fn set(self, s: &mut Settings, v: u32) {
+        match self {
+            Knob::RenderSpp => s.render.spp = v,
+            Knob::EstimateSpp => s.estimate.spp = v,
+            Knob::SplatPasses => s.estimate.splat.passes = v,
+            Knob::SppmPasses => s.estimate.sppm.passes = v,
+        }
+    }
+}
+
+/// What the method table says of a method's flags, for [`Settings::parse`].
+#[derive(Clone, Copy, Debug)]
+pub struct Flags {
+    /// Where `--spp` goes (`None`: the method takes no `--spp`).
+    pub spp: Option<Knob>,
+    /// Where `--passes` goes (`None`: the method has no passes, nor `--time`).
+    pub passes: Option<Knob>,
+    /// It runs the path tracer, which `--no-caustics` configures.
+    pub path_tracer: bool,
+}
+
 impl Settings {
-    /// Parses the scene's tables and applies `o`. Errors name the scene file.
-    pub fn new(scene: &Scene, o: &Overrides) -> Result<Settings, String> {
+    /// Parses the scene's tables and applies `o`, the method-dependent flags where `flags` of
+    /// the method (`o`'s, else the scene's) say. Errors name the scene file. Callers use
+    /// `Settings::new`, which asks the method table for `flags`.
+    pub fn parse(
+        scene: &Scene,
+        o: &Overrides,
+        flags: &dyn Fn(Method) -> Flags,
+    ) -> Result<Settings, String> {
         let file = &scene.file;
         let err = |m: String| format!("{}: {m}", scene.path.display());
         let mut emit: EmitParams = toml::Value::Table(file.photons.clone())
@@ -203,21 +264,13 @@ impl Settings {
         if let Some(n) = o.photons {
             emit.photons = n;
         }
-        let spec = crate::methods::spec(method);
-        if let Some(spp) = o.spp {
-            if spec.estimate_spp {
-                estimate.spp = spp;
-            } else {
-                render.spp = spp;
-            }
+        let flags = flags(method);
+        if o.caustics.is_some() && !flags.path_tracer {
+            return Err(format!(
+                "--no-caustics applies to the path tracer; {method} takes caustics from photons"
+            ));
         }
         if let Some(c) = o.caustics {
-            if spec.estimate_spp {
-                return Err(format!(
-                    "--no-caustics applies to the path tracer; {method} takes caustics from \
-                     photons"
-                ));
-            }
             render.caustics = c;
         }
         let g = &mut estimate.global;
@@ -242,14 +295,6 @@ impl Settings {
         if let Some(c) = o.gather_cache {
             estimate.final_gather.cache = c;
         }
-        if let Some(p) = o.passes {
-            match method {
-                Method::Sppm => estimate.sppm.passes = p,
-                // The path tracer's passes are samples per pixel.
-                Method::Path => render.spp = p,
-                _ => estimate.splat.passes = p,
-            }
-        }
         if let Some(n) = o.splat_photons {
             estimate.splat.photons = n;
         }
@@ -261,24 +306,35 @@ impl Settings {
         {
             return Err(format!("--time {t} must be a positive number of seconds"));
         }
-        let s = Settings {
+        if o.time.is_some() && flags.passes.is_none() {
+            return Err(format!(
+                "--time: {method} renders in one go, without passes to stop after (the \
+                 progressive methods take it)"
+            ));
+        }
+        let mut s = Settings {
             method,
             time: o.time,
             render,
             emit,
             estimate,
         };
+        for (flag, value, knob) in [
+            ("--spp", o.spp, flags.spp),
+            ("--passes", o.passes, flags.passes),
+        ] {
+            match (value, knob) {
+                (Some(v), Some(k)) => k.set(&mut s, v),
+                (Some(_), None) => {
+                    return Err(format!(
+                        "{flag}: {method} takes no {flag} (see `photonflow render --help`)"
+                    ));
+                }
+                (None, _) => {}
+            }
+        }
         s.validate().map_err(err)?;
         Ok(s)
-    }
-
-    /// Samples per pixel of the method.
-    pub fn spp(&self) -> u32 {
-        if crate::methods::spec(self.method).estimate_spp {
-            self.estimate.spp
-        } else {
-            self.render.spp
-        }
     }
 
     /// What an image made with these settings depends on: the scene's view and seed

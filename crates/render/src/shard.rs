@@ -22,7 +22,7 @@ pub const SUMS: &str = "sums.f64";
 pub fn render(run: &Run, shard: ShardId, out: &Path) -> Result<Manifest, String> {
     let (scene, settings) = (run.scene, run.settings);
     let method = settings.method;
-    let blocks_fn = methods::spec(method)
+    let blocks_fn = methods::row(method)
         .blocks
         .map_err(|why| format!("--shard cannot split `{method}`: {why}"))?;
     if settings.time.is_some() {
@@ -138,7 +138,7 @@ fn merge_image(all: &[Input], order: &[usize], out: &Path) -> Result<String, Str
         photons: methods::Photons::CacheOnly,
         threads: Some(1),
     };
-    let blocks_fn = methods::spec(settings.method)
+    let blocks_fn = methods::row(settings.method)
         .blocks
         .map_err(|why| format!("{}: {why}", m0.display()))?;
     let mut b = blocks_fn(&run);

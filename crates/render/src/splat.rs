@@ -1,8 +1,9 @@
-//! Photon differential splatting onto eye vertices (Frisvad et al. 2014): a pass's eye
-//! vertices (E S* D) are indexed once; caustic photons with differentials (L S+ D, `emit`)
-//! are traced in chunks on the pipeline's workers, and each photon adds to every eye vertex
-//! inside its footprint `Φ_p K(|M (y - x_p)|) |det M|` (`density::splat`), accepting only
-//! vertices on the same surface and side. With `indirect` on, each caustic path goes on past
+//! Photon differential splatting onto eye vertices (Frisvad et al. 2014), the stage on the
+//! channel pipeline: a pass's eye vertices (E S* D) are indexed once; caustic photons with
+//! differentials (L S+ D, `emit`) are traced in chunks on the pipeline's workers, and each
+//! photon adds to every eye vertex inside its footprint `Φ_p K(|M (y - x_p)|) |det M|`,
+//! accepting only vertices on the same surface and side (the accumulation is
+//! `density::splat`'s). With `indirect` on, each caustic path goes on past
 //! its first diffuse hit and adds at every later diffuse hit (L S+ D (S* D)+) by a disc of
 //! `indirect_radius` instead: after a diffuse bounce the photons no longer focus, and their
 //! density is as smooth as a global photon map's, so the caustics seen through a diffuse
@@ -15,91 +16,39 @@
 //! thread count).
 
 use crate::settings::SplatSettings;
-use density::splat::Footprint;
-use density::{Index, IndexKind, Neighbor};
+use density::splat::{Receiver, Receivers, Scratch, SplatParams, SplatPhoton, splat};
 use emit::{CausticPhoton, EmitParams};
 use eye::{EyeVertex, VertexOptions};
 use flow::{PipelineOptions, Stats};
 use glam::{DVec3, Vec3};
 use scene::Scene;
 
-/// How far off the photon's tangent plane a vertex may lie, relative to its distance: the
-/// topological test of the k-NN estimates (keeps a splat on its own surface).
-const TOPO_EPS: f32 = 0.1;
-/// Smallest cosine between a vertex's normal and the photon's: same surface, same side.
-const SAME_SIDE_COS: f32 = 0.9;
-
-/// Eye vertices under kd-trees, one per spacing level: the vertices whose spacing lies in
-/// `(2^(l-1), 2^l]` share level `l`, which records the largest spacing among them.
-///
-/// Levels, not one tree, because a splat must be at least as wide as the spacing of the
-/// vertices that read it, and vertices of very different spacing share a surface: the floor
-/// under a glass ball is seen both directly (coarse at a low camera) and through the ball
-/// (fine). A footprint clamped to the nearest vertex's spacing, as splats were first made,
-/// is then often the fine set's and falls between the coarse set's vertices: on the caustic
-/// focus of `tests/it/hard_cases.rs` the directly seen floor kept 80% of the focused flux
-/// (34% of the photons whose nearest vertex was seen through the ball). Each level now reads
-/// a photon through its own footprint, clamped to the level's spacing, so each set of
-/// vertices integrates every photon to its flux: the lower clamp of Frisvad et al. 2014's
-/// stability discussion, taken per sampling density since the eye's sampling of a surface
-/// varies with the eye path that reached it. Cost: one range search per level (a few) per
-/// photon; a 128 x 128 worksheet caustic-splat run took 1.03 s against 0.78 s.
-pub struct EyeIndex {
-    levels: Vec<Level>,
-    vertices: Vec<EyeVertex>,
-}
-
-/// The vertices of one spacing level.
-struct Level {
-    /// Largest spacing of the level's vertices (infinite for vertices without a finite
-    /// positive spacing, which the clamp then widens to the largest footprint).
-    spacing: f32,
-    index: Index,
-    /// Vertex ids (into `EyeIndex::vertices`) by the level index's point order.
-    ids: Vec<u32>,
-}
-
-impl EyeIndex {
-    pub fn new(vertices: Vec<EyeVertex>) -> EyeIndex {
-        let mut by_level: std::collections::BTreeMap<i32, (f32, Vec<u32>)> =
-            std::collections::BTreeMap::new();
-        for (i, v) in vertices.iter().enumerate() {
-            let (key, spacing) = if v.spacing.is_finite() && v.spacing > 0.0 {
-                (v.spacing.log2().ceil() as i32, v.spacing)
-            } else {
-                (i32::MAX, f32::INFINITY)
-            };
-            let e = by_level.entry(key).or_insert((0.0, Vec::new()));
-            e.0 = e.0.max(spacing);
-            e.1.push(i as u32);
-        }
-        let levels = by_level
-            .into_values()
-            .map(|(spacing, ids)| {
-                let points: Vec<[f32; 3]> = ids
-                    .iter()
-                    .map(|&i| vertices[i as usize].p.to_array())
-                    .collect();
-                Level {
-                    spacing,
-                    index: Index::build(IndexKind::KdTree, &points),
-                    ids,
-                }
+/// Eye vertices as the receivers splatting reads (`density::splat`), indexed: the levels by
+/// spacing of `density::splat::Receivers` keep a splat at least as wide as the spacing of the
+/// vertices that read it, per sampling density (see there).
+pub fn receivers(vertices: Vec<EyeVertex>) -> Receivers {
+    Receivers::new(
+        vertices
+            .into_iter()
+            .map(|v| Receiver {
+                pixel: v.pixel,
+                p: v.p,
+                ng: v.ng,
+                weight: v.weight,
+                spacing: v.spacing,
             })
-            .collect();
-        EyeIndex { levels, vertices }
-    }
+            .collect(),
+    )
+}
 
-    pub fn len(&self) -> usize {
-        self.vertices.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.vertices.is_empty()
-    }
-
-    pub fn vertices(&self) -> &[EyeVertex] {
-        &self.vertices
+/// A caustic photon as splatting reads it.
+pub fn splat_photon(p: &CausticPhoton) -> SplatPhoton {
+    SplatPhoton {
+        position: p.position,
+        normal: p.normal,
+        flux: p.flux,
+        a: p.a,
+        b: p.b,
     }
 }
 
@@ -110,8 +59,8 @@ pub fn eye_index(
     spp: u32,
     pass: u64,
     threads: Option<usize>,
-) -> EyeIndex {
-    EyeIndex::new(eye::eye_vertices(
+) -> Receivers {
+    receivers(eye::eye_vertices(
         scene,
         &VertexOptions {
             spp,
@@ -120,92 +69,6 @@ pub fn eye_index(
             pass,
         },
     ))
-}
-
-/// Scratch space of one worker.
-#[derive(Default)]
-pub struct Scratch {
-    near: Vec<Neighbor>,
-}
-
-/// The footprint of `p` as the vertices of spacing `spacing` read it: its differentials,
-/// each principal semi-axis no thinner than `spacing` (else the splat falls between those
-/// vertices) and no wider than `max_radius`.
-pub fn footprint(p: &CausticPhoton, spacing: f32, max_radius: f32) -> Option<Footprint> {
-    let min_len = spacing.clamp(max_radius * 1e-6, max_radius);
-    Footprint::new(p.position, p.normal, p.a, p.b, min_len, max_radius)
-}
-
-/// Adds what `photons` deposit at the eye vertices to `out`, as `(pixel, radiance)` pairs
-/// in photon order, then by spacing level and vertex. Each level reads a photon through its
-/// own footprint ([`footprint`] with the level's spacing; see [`EyeIndex`]). `isotropic > 0`
-/// replaces every footprint by a disc of that radius (the fixed-radius splatting that
-/// differentials improve on).
-pub fn splat(
-    eyes: &EyeIndex,
-    photons: &[CausticPhoton],
-    max_radius: f32,
-    isotropic: f32,
-    scratch: &mut Scratch,
-    out: &mut Vec<(u32, DVec3)>,
-) {
-    for p in photons {
-        if !p.flux.is_finite() {
-            continue;
-        }
-        let flux = p.flux.as_dvec3();
-        let disc = if isotropic > 0.0 {
-            let frame = math::Frame::from_z(p.normal);
-            Footprint::new(
-                p.position,
-                p.normal,
-                isotropic * frame.s,
-                isotropic * frame.t,
-                isotropic,
-                isotropic,
-            )
-        } else {
-            None
-        };
-        // Levels at or below the unclamped footprint's minor axis read it as it is: one
-        // footprint for them all.
-        let mut shared: Option<(f32, Option<Footprint>)> = None;
-        for level in &eyes.levels {
-            let f = if isotropic > 0.0 {
-                disc
-            } else {
-                let free = *shared.get_or_insert_with(|| {
-                    let f = footprint(p, 0.0, max_radius);
-                    (f.map_or(f32::INFINITY, |f| f.axes[1]), f)
-                });
-                if level.spacing <= free.0 {
-                    free.1
-                } else {
-                    footprint(p, level.spacing, max_radius)
-                }
-            };
-            let Some(f) = f else {
-                continue;
-            };
-            level
-                .index
-                .within(p.position, f.radius(), &mut scratch.near);
-            for nb in &scratch.near {
-                let v = &eyes.vertices[level.ids[nb.index as usize] as usize];
-                let d = v.p - p.position;
-                if v.ng.dot(f.normal) < SAME_SIDE_COS
-                    || d.dot(f.normal).abs() > TOPO_EPS * d.length() + 1e-4 * f.axes[1]
-                {
-                    continue;
-                }
-                let w = f.weight(v.p);
-                if w > 0.0 {
-                    let e = flux * w;
-                    out.push((v.pixel, v.weight.as_dvec3() * e));
-                }
-            }
-        }
-    }
 }
 
 /// The radius of the disc by which photons after a diffuse bounce reach eye vertices: the
@@ -238,7 +101,7 @@ pub struct Splatter<'a> {
     pub scene: &'a Scene,
     pub params: &'a EmitParams,
     pub settings: &'a SplatSettings,
-    pub eyes: &'a EyeIndex,
+    pub eyes: &'a Receivers,
 }
 
 /// One chunk's photon count and its `(pixel, radiance)` pairs: `[0]` from photons at their
@@ -270,13 +133,20 @@ impl Splatter<'_> {
                 photons.into_iter().partition(|p| p.diffuse == 1);
             let mut out = [Vec::new(), Vec::new()];
             let mut scratch = Scratch::default();
-            let iso = s.isotropic_radius;
-            splat(eyes, &first, max_r, iso, &mut scratch, &mut out[0]);
+            let first_params = SplatParams::new(max_r, s.isotropic_radius);
+            let bounced_params = SplatParams::new(indirect_r, indirect_r);
+            let (first, bounced) = (first.iter(), bounced.iter());
             splat(
                 eyes,
-                &bounced,
-                indirect_r,
-                indirect_r,
+                first.map(splat_photon),
+                &first_params,
+                &mut scratch,
+                &mut out[0],
+            );
+            splat(
+                eyes,
+                bounced.map(splat_photon),
+                &bounced_params,
                 &mut scratch,
                 &mut out[1],
             );

@@ -98,3 +98,47 @@ fn estimate_params_round_trip_through_toml() {
     assert_eq!(p.kernel, Kernel::Silverman);
     assert_eq!(p.k, 50);
 }
+
+#[test]
+fn kernel_names_round_trip_and_are_the_serde_kind_tags() {
+    let cone = Kernel::Cone { k: 2.5 };
+    for k in Kernel::ALL.into_iter().chain([cone]) {
+        let name = k.to_string();
+        assert_eq!(name.parse::<Kernel>(), Ok(k), "{name}");
+        // The tag scene files spell: `kernel = { kind = "..." }`.
+        let table = toml::Table::try_from(k).unwrap();
+        let tag = table["kind"].as_str().unwrap();
+        if k == cone {
+            assert_eq!(name, "cone:2.5");
+            assert_eq!(tag, "cone");
+        } else {
+            assert_eq!(name, tag, "{k:?}");
+        }
+    }
+    assert_eq!(Kernel::Cone { k: 1.0 }.to_string(), "cone");
+    assert_eq!("cone:1".parse(), Ok(Kernel::Cone { k: 1.0 }));
+    assert_eq!("box".parse(), Ok(Kernel::Uniform));
+    assert_eq!("simpson".parse(), Ok(Kernel::Silverman));
+}
+
+#[test]
+fn unknown_kernel_names_are_refused_with_the_valid_ones_listed() {
+    for bad in [
+        "",
+        "gauss",
+        "gaussian-jensen",
+        "Uniform",
+        "cone:",
+        "cone:0.5",
+        "cone:inf",
+        "cone:NaN",
+        "cone:x",
+        "uniform:2",
+    ] {
+        let err = bad.parse::<Kernel>().unwrap_err();
+        for k in Kernel::ALL {
+            assert!(err.contains(&k.to_string()), "{bad}: {err}");
+        }
+        assert!(err.contains("cone:K"), "{bad}: {err}");
+    }
+}

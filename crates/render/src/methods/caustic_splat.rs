@@ -3,7 +3,7 @@
 //! bounces) by photon differential splatting onto eye vertices, with no photon map (the
 //! course framework's `splat_caustics_map`). `[estimate.splat]` holds its knobs.
 
-use super::{CountKind, Layer, Rendered, Run, Snapshot};
+use super::{CountKind, Layer, Rendered, Run};
 use crate::splat;
 use film::Class;
 
@@ -206,43 +206,34 @@ impl super::Accumulate for Progressive<'_> {
         let mut info = self.facts();
         info.insert("time_render_s".into(), seconds.into());
         Rendered {
-            layers: self.layers(),
-            plan: None,
-            info,
             passes: Some(self.passes),
-            samples: None,
-            snapshots: Vec::new(),
+            ..Rendered::new(self.layers(), info)
         }
     }
 }
 
-/// Passes until the count, or the time budget once a pass has been made; a snapshot after
-/// 1, 2, 4, ... passes and the last.
-pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
-    let sp = &run.settings.estimate.splat;
-    let t0 = std::time::Instant::now();
-    let mut splat = Progressive::new(run);
-    let mut snapshots = Vec::new();
-    while splat.passes < sp.passes {
-        splat.step(progress)?;
-        let elapsed = t0.elapsed().as_secs_f64();
-        if splat.passes.is_power_of_two() || splat.passes == sp.passes {
-            snapshots.push(Snapshot {
-                passes: splat.passes,
-                seconds: elapsed,
-                layers: splat.layers(),
-            });
-        }
-        if run.settings.time.is_some_and(|t| elapsed >= t) {
-            break;
-        }
+impl crate::passes::Progressive for Progressive<'_> {
+    fn done(&self) -> u32 {
+        self.passes
     }
-    Ok(Rendered {
-        layers: splat.layers(),
-        plan: None,
-        info: splat.facts(),
-        passes: Some(splat.passes),
-        samples: None,
-        snapshots,
-    })
+
+    fn total(&self) -> u32 {
+        self.run.settings.estimate.splat.passes
+    }
+
+    fn step(&mut self, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
+        Progressive::step(self, progress)
+    }
+
+    fn layers(&self) -> Vec<Layer> {
+        Progressive::layers(self)
+    }
+
+    fn finish(&self, seconds: f64) -> Rendered {
+        super::Accumulate::finish(self, seconds)
+    }
+}
+
+pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
+    crate::passes::run(&mut Progressive::new(run), run.settings.time, progress)
 }

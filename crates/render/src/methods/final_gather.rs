@@ -75,9 +75,6 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
             ],
         )?,
         plan: Some(inputs.plan),
-        info,
-        passes: None,
-        samples: None,
-        snapshots: Vec::new(),
+        ..Rendered::new(Vec::new(), info)
     })
 }

@@ -1,8 +1,10 @@
-//! The methods, one file each, behind one dispatch: [`spec`] matches `scene::Method` and
-//! nothing else does; everything else asks the [`MethodSpec`] it returns. A method gets a [`Run`] (the scene, its settings, where photon sets are
-//! cached and whether it may trace them) and returns [`Rendered`] layers, each tagged with
-//! the light-path classes it estimates so that layers of separate runs can be composited
-//! without counting a path twice.
+//! The methods, one file each, behind one table: [`METHODS`] has a row per method saying what
+//! it reads, where `--spp` and `--passes` go, how the passes it made are recorded, what its
+//! progress counts, whether it shards, and its `--help` line; everything else asks the row
+//! ([`row`]). A method gets a [`Run`] (the scene, its settings, where photon sets are cached
+//! and whether it may trace them) and returns [`Rendered`] layers, each tagged with the
+//! light-path classes it estimates so that layers of separate runs can be composited without
+//! counting a path twice. The progressive methods run in `crate::passes`' one loop.
 
 mod caustic_splat;
 mod final_gather;
@@ -14,7 +16,7 @@ mod sppm;
 pub use sppm::start_radius;
 
 use crate::maps::Maps;
-use crate::settings::Settings;
+use crate::settings::{Flags, Knob, Overrides, Settings};
 use emit::Plan;
 use film::{Film, Image, Normalize};
 use photons::cache::{self as photon_cache, CacheKey};
@@ -88,6 +90,20 @@ pub struct Rendered {
     pub snapshots: Vec<Snapshot>,
 }
 
+impl Rendered {
+    /// Layers and facts, nothing else: no plan, passes, samples or snapshots.
+    pub fn new(layers: Vec<Layer>, info: serde_json::Map<String, serde_json::Value>) -> Rendered {
+        Rendered {
+            layers,
+            plan: None,
+            info,
+            passes: None,
+            samples: None,
+            snapshots: Vec::new(),
+        }
+    }
+}
+
 /// A progressive method's image after some passes.
 pub struct Snapshot {
     pub passes: u32,
@@ -99,21 +115,6 @@ pub struct Snapshot {
 /// What a layer's count counts: the compositing stage's own type, so `image.json` is spelled
 /// in one place.
 pub use composite::CountKind;
-
-/// What the rest of the program needs to know of a method.
-pub struct MethodSpec {
-    pub render: RenderFn,
-    /// Its run as independent blocks of work, which shards split (`None`: it cannot be
-    /// split exactly, and the string says why).
-    pub blocks: Result<BlocksFn, &'static str>,
-    /// It reads photon maps: `estimate` may run it from cached photon sets.
-    pub photon_maps: bool,
-    /// Its samples per pixel (and `--spp`) are `[estimate] spp` (else `[render] spp`, the
-    /// path tracer's).
-    pub estimate_spp: bool,
-    /// Its progress counts splatted photons (else pixel samples).
-    pub splat_progress: bool,
-}
 
 type RenderFn = fn(&Run, &(dyn Fn(u64) + Sync)) -> Result<Rendered, String>;
 
@@ -147,43 +148,204 @@ pub trait Accumulate {
     fn finish(&self, seconds: f64) -> Rendered;
 }
 
-/// The one `match` on `scene::Method`.
-pub fn spec(method: Method) -> MethodSpec {
-    // (render, photon maps, estimate spp, splat progress)
-    let (render, photon_maps, estimate_spp, splat_progress): (RenderFn, bool, bool, bool) =
-        match method {
-            Method::Path => (path::render, false, false, false),
-            Method::GlobalDirect => (global_direct::render, true, true, false),
-            Method::FinalGather => (final_gather::render, true, true, false),
-            Method::CausticSplat => (caustic_splat::render, false, true, true),
-            // The path tracer's spp; its splat's eye vertices take `[estimate] spp`.
-            Method::PathSplat => (path_splat::render, false, false, false),
-            // One camera sample per pixel and pass; progress counts them.
-            Method::Sppm => (sppm::render, false, false, false),
-        };
-    let blocks: Result<BlocksFn, &'static str> = match method {
-        Method::Path => Ok(path::blocks),
-        Method::CausticSplat => Ok(caustic_splat::blocks),
-        Method::Sppm => Err(
+/// What a method reads besides the scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Input {
+    /// Eye paths of the path tracer.
+    EyePaths,
+    /// Cached photon maps (`estimate` may run the method from them alone).
+    PhotonMaps,
+    /// Eye vertices (E S* D) that caustic photons are splatted onto.
+    EyeVertices,
+    /// SPPM's visible points, one per pixel and pass.
+    VisiblePoints,
+}
+
+/// What a method's progress bar counts, in total.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Work {
+    /// Pixel samples: width x height x the knob.
+    PixelSamples(Knob),
+    /// Caustic photon paths splatted: per pass x passes (`[estimate.splat]`).
+    SplatPhotons,
+}
+
+/// One row of the method table: everything the rest of the program asks of a method.
+pub struct MethodRow {
+    pub method: Method,
+    /// Its line in `--help` and in README's method list.
+    pub help: &'static str,
+    /// Its knobs in the scene file.
+    pub table: &'static str,
+    pub reads: &'static [Input],
+    /// Where `--spp` goes (`None`: refused).
+    pub spp: Option<Knob>,
+    /// Where `--passes` goes and where the passes a run made are recorded (`None`: it
+    /// renders in one go, and refuses `--passes` and `--time`). Samples per pixel a run
+    /// made are recorded as `[render] spp`.
+    pub passes: Option<Knob>,
+    pub work: Work,
+    /// It renders the whole image (else only the layers of the classes it names).
+    pub whole_image: bool,
+    pub render: RenderFn,
+    /// Its run as independent blocks of work, which shards split (`Err`: it cannot be
+    /// split exactly, and the string says why).
+    pub blocks: Result<BlocksFn, &'static str>,
+}
+
+impl MethodRow {
+    /// What [`Settings::parse`] needs of the row.
+    pub fn flags(&self) -> Flags {
+        Flags {
+            spp: self.spp,
+            passes: self.passes,
+            path_tracer: self.reads.contains(&Input::EyePaths),
+        }
+    }
+
+    /// It reads photon maps: `estimate` may run it from cached photon sets.
+    pub fn reads_photon_maps(&self) -> bool {
+        self.reads.contains(&Input::PhotonMaps)
+    }
+}
+
+/// The method table: one row per `scene::Method`, in `Method::ALL`'s order. Nothing else
+/// matches on `Method`.
+pub static METHODS: [MethodRow; 6] = [
+    MethodRow {
+        method: Method::Path,
+        help: "the path-traced reference: next-event estimation and BSDF sampling by MIS, in \
+               passes of samples per pixel",
+        table: "[render]",
+        reads: &[Input::EyePaths],
+        spp: Some(Knob::RenderSpp),
+        // The path tracer's passes are samples per pixel.
+        passes: Some(Knob::RenderSpp),
+        work: Work::PixelSamples(Knob::RenderSpp),
+        whole_image: true,
+        render: path::render,
+        blocks: Ok(path::blocks),
+    },
+    MethodRow {
+        method: Method::GlobalDirect,
+        help: "the global photon map shown directly at the first diffuse surface seen \
+               (trace or reuse the photons, then estimate)",
+        table: "[estimate.global]",
+        reads: &[Input::PhotonMaps],
+        spp: Some(Knob::EstimateSpp),
+        passes: None,
+        work: Work::PixelSamples(Knob::EstimateSpp),
+        whole_image: true,
+        render: global_direct::render,
+        blocks: Err(PHOTON_MAP_SHARDS),
+    },
+    MethodRow {
+        method: Method::FinalGather,
+        help: "next-event estimation, the caustic map and final gathering into the global \
+               map through an irradiance cache (Christensen 1999)",
+        table: "[estimate.final_gather]",
+        reads: &[Input::PhotonMaps],
+        spp: Some(Knob::EstimateSpp),
+        passes: None,
+        work: Work::PixelSamples(Knob::EstimateSpp),
+        whole_image: true,
+        render: final_gather::render,
+        blocks: Err(PHOTON_MAP_SHARDS),
+    },
+    MethodRow {
+        method: Method::CausticSplat,
+        help: "the caustic layers alone, by photon differential splatting onto eye vertices \
+               (no photon map), in passes",
+        table: "[estimate.splat]",
+        reads: &[Input::EyeVertices],
+        spp: Some(Knob::EstimateSpp),
+        passes: Some(Knob::SplatPasses),
+        work: Work::SplatPhotons,
+        whole_image: false,
+        render: caustic_splat::render,
+        blocks: Ok(caustic_splat::blocks),
+    },
+    MethodRow {
+        method: Method::PathSplat,
+        help: "the path tracer without the paths splatting owns, plus the splatted caustic \
+               layers, interleaved in passes",
+        table: "[render] and [estimate.splat]",
+        reads: &[Input::EyePaths, Input::EyeVertices],
+        // The path tracer's samples; its splat's eye vertices take `[estimate] spp`.
+        spp: Some(Knob::RenderSpp),
+        passes: Some(Knob::SplatPasses),
+        work: Work::PixelSamples(Knob::RenderSpp),
+        whole_image: true,
+        render: path_splat::render,
+        blocks: Err(
+            "path+splat interleaves two progressions: shard `path --no-caustics` and \
+             `caustic-splat` apart and `composite` the two merged runs",
+        ),
+    },
+    MethodRow {
+        method: Method::Sppm,
+        help: "stochastic progressive photon mapping (Hachisuka and Jensen 2009): new visible \
+               points and photons every pass, radii shrinking per pixel; consistent",
+        table: "[estimate.sppm]",
+        reads: &[Input::VisiblePoints],
+        // One camera sample per pixel and pass.
+        spp: None,
+        passes: Some(Knob::SppmPasses),
+        work: Work::PixelSamples(Knob::SppmPasses),
+        whole_image: true,
+        render: sppm::render,
+        blocks: Err(
             "sppm's passes depend on each other (every pass shrinks the radii the next one \
              gathers in), so no range of them can run apart: shard `caustic-splat` or \
              `path`, or render independent seeds and `composite` them",
         ),
-        Method::PathSplat => Err(
-            "path+splat interleaves two progressions: shard `path --no-caustics` and \
-             `caustic-splat` apart and `composite` the two merged runs",
-        ),
-        Method::GlobalDirect | Method::FinalGather => Err(
-            "the photon-map methods estimate from one photon map: shard `trace`, `merge` \
-             its photon sets into the cache, then `estimate`",
-        ),
-    };
-    MethodSpec {
-        render,
-        blocks,
-        photon_maps,
-        estimate_spp,
-        splat_progress,
+    },
+];
+
+const PHOTON_MAP_SHARDS: &str = "the photon-map methods estimate from one photon map: shard \
+    `trace`, `merge` its photon sets into the cache, then `estimate`";
+
+/// The method's row of [`METHODS`].
+pub fn row(method: Method) -> &'static MethodRow {
+    // Every method has its row (tested), so the fallback is never taken.
+    METHODS
+        .iter()
+        .find(|r| r.method == method)
+        .unwrap_or(&METHODS[0])
+}
+
+/// The methods and their help lines, one per line, for `--help`.
+pub fn help() -> String {
+    METHODS
+        .iter()
+        .map(|r| format!("{}: {}", r.method, r.help))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+impl Settings {
+    /// Parses the scene's tables and applies `o`: the flags whose place depends on the method
+    /// go where its row of the method table says. Errors name the scene file or the flag.
+    pub fn new(scene: &Scene, o: &Overrides) -> Result<Settings, String> {
+        Settings::parse(scene, o, &|m| row(m).flags())
+    }
+
+    /// Samples per pixel of the method's eye pass (one for SPPM's visible points).
+    pub fn spp(&self) -> u32 {
+        row(self.method).spp.map_or(1, |k| k.get(self))
+    }
+
+    /// These settings with the passes and samples per pixel a run made recorded, so the
+    /// resolved scene file reproduces a run a time budget stopped.
+    pub fn with_made(&self, r: &Rendered) -> Settings {
+        let mut s = self.clone();
+        if let (Some(p), Some(k)) = (r.passes, row(self.method).passes) {
+            k.set(&mut s, p);
+        }
+        if let Some(n) = r.samples {
+            Knob::RenderSpp.set(&mut s, n);
+        }
+        s
     }
 }
 
@@ -192,20 +354,25 @@ pub fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, St
     if run.threads == Some(0) {
         return Err("--threads must be at least 1".into());
     }
-    (spec(run.settings.method).render)(run, progress)
+    (row(run.settings.method).render)(run, progress)
 }
 
-/// Total work units (samples) of a run, for a progress bar.
-pub fn work(run: &Run) -> u64 {
-    let (w, h) = (
-        run.scene.camera.width as u64,
-        run.scene.camera.height as u64,
-    );
-    let samples = match run.settings.method {
-        Method::Sppm => run.settings.estimate.sppm.passes,
-        _ => run.settings.spp(),
-    };
-    w * h * samples as u64
+/// Total work of a run for a progress bar, and what it counts.
+pub fn work(run: &Run) -> (u64, &'static str) {
+    let s = run.settings;
+    let pixels = run.scene.camera.width as u64 * run.scene.camera.height as u64;
+    match row(s.method).work {
+        Work::PixelSamples(k) => (pixels * k.get(s) as u64, "samples"),
+        Work::SplatPhotons => {
+            let sp = &s.estimate.splat;
+            let per_pass = if sp.photons > 0 {
+                sp.photons
+            } else {
+                s.emit.photons
+            };
+            (per_pass.saturating_mul(sp.passes as u64), "photons")
+        }
+    }
 }
 
 /// How one film layer is described: name, classes, count, count kind.

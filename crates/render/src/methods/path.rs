@@ -2,14 +2,13 @@
 //! pixel. With `render.caustics` off it leaves out the paths splatting owns: the `caustic`
 //! layer, and `caustic_indirect` too when `[estimate.splat] indirect` is on.
 //!
-//! Progressive: the samples are rendered in passes of 1, 1, 2, 4, ... samples per pixel, at
-//! most an eighth of the run each (so a pass never takes more than the time already spent,
-//! or an eighth of the run; passes cost a film each, so there are few of them), pixel sample
-//! `s` drawing what it would in one run of all of them, with a snapshot whenever the samples
-//! so far are a power of two; a time budget (`--time`) stops after the pass that reaches it
-//! and records the samples made.
+//! Progressive (`crate::passes`): the samples are rendered in passes of 1, 1, 2, 4, ...
+//! samples per pixel, at most an eighth of the run each (so a pass never takes more than the
+//! time already spent, or an eighth of the run; passes cost a film each, so there are few of
+//! them), pixel sample `s` drawing what it would in one run of all of them; a time budget
+//! stops after the pass that reaches it and records the samples made.
 
-use super::{CountKind, Layer, Rendered, Run, Snapshot};
+use super::{CountKind, Layer, Rendered, Run};
 use film::Class;
 use glam::DVec3;
 
@@ -56,6 +55,11 @@ impl<'a> Progressive<'a> {
             samples: 0,
             blocks: 0,
         }
+    }
+
+    /// Passes (blocks) added so far.
+    pub(super) fn passes(&self) -> u32 {
+        self.blocks
     }
 
     /// Samples of the next pass of a run of `spp` (see [`next_pass`]).
@@ -216,45 +220,34 @@ impl super::Accumulate for Progressive<'_> {
 
     fn finish(&self, seconds: f64) -> Rendered {
         Rendered {
-            layers: self.layers(),
-            plan: None,
-            info: self.facts(seconds, self.blocks),
-            passes: None,
             samples: Some(self.samples),
-            snapshots: Vec::new(),
+            ..Rendered::new(self.layers(), self.facts(seconds, self.blocks))
         }
     }
 }
 
-pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
-    let r = &run.settings.render;
-    let t0 = std::time::Instant::now();
-    let mut image = Progressive::new(run);
-    let mut snapshots = Vec::new();
-    let mut passes = 0;
-    while image.samples < r.spp {
-        image.step(image.next_pass(r.spp), progress)?;
-        passes += 1;
-        let elapsed = t0.elapsed().as_secs_f64();
-        let done = image.samples;
-        if done.is_power_of_two() || done == r.spp {
-            snapshots.push(Snapshot {
-                passes: done,
-                seconds: elapsed,
-                layers: image.layers(),
-            });
-        }
-        if run.settings.time.is_some_and(|t| elapsed >= t) {
-            break;
-        }
+impl crate::passes::Progressive for Progressive<'_> {
+    fn done(&self) -> u32 {
+        self.samples
     }
-    let seconds = t0.elapsed().as_secs_f64();
-    Ok(Rendered {
-        layers: image.layers(),
-        plan: None,
-        info: image.facts(seconds, passes),
-        passes: None,
-        samples: Some(image.samples),
-        snapshots,
-    })
+
+    fn total(&self) -> u32 {
+        self.run.settings.render.spp
+    }
+
+    fn step(&mut self, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
+        Progressive::step(self, self.next_pass(self.total()), progress)
+    }
+
+    fn layers(&self) -> Vec<Layer> {
+        Progressive::layers(self)
+    }
+
+    fn finish(&self, seconds: f64) -> Rendered {
+        super::Accumulate::finish(self, seconds)
+    }
+}
+
+pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
+    crate::passes::run(&mut Progressive::new(run), run.settings.time, progress)
 }

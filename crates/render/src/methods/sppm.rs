@@ -13,13 +13,13 @@
 //! shrink so that bias vanishes while the photon count in them still grows, so the error
 //! goes to zero (consistent), unlike a fixed k or radius.
 
-use super::{CountKind, Layer, Rendered, Run, Snapshot};
+use super::{CountKind, Layer, Rendered, Run};
 use crate::settings::SppmSettings;
+use density::sppm::PixelStats;
 use density::{IndexKind, PhotonMap};
 use emit::{EmitParams, Plan};
 use film::Class;
 use flow::PipelineOptions;
-use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use scene::Scene;
 use store::MapKind;
@@ -28,16 +28,6 @@ use store::MapKind;
 /// the scene's total diffuse area would be: enough to keep the first passes from being
 /// blotchy, few enough for their bias to fade within a few passes.
 const START_PHOTONS: f64 = 32.0;
-
-/// A pixel's running statistics.
-#[derive(Clone, Copy, Debug)]
-struct Stats {
-    n: f64,
-    tau: DVec3,
-    r: f32,
-    /// Sum over passes of emission and direct light.
-    light: DVec3,
-}
 
 /// The automatic start radius: the radius holding [`START_PHOTONS`] photons of one pass if
 /// they spread evenly over the scene's diffuse area, but at least two pixel footprints at
@@ -96,155 +86,175 @@ fn pass_photons(
     Ok(photons)
 }
 
-pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
-    let scene = run.scene;
-    let s = run.settings;
-    let sp: &SppmSettings = &s.estimate.sppm;
-    let mut params = s.emit.clone();
-    if sp.photons > 0 {
-        params.photons = sp.photons;
-    }
-    // Photons at every diffuse hit, the first one only if no next-event estimation.
-    params.global = true;
-    params.caustic = false;
-    params.store_direct = !sp.direct;
-    let plan =
-        Plan::for_scene(scene, &params).map_err(|e| format!("{}: {e}", scene.path.display()))?;
-    // No diffuse surface (all black, or only mirrors and glass): a valid scene whose photon
-    // layer is black; the passes still average what the eye sees of the emitters.
-    if !plan.global {
-        print!("{plan}");
-    }
-    let est = s.estimate.global;
-    let r0 = if sp.radius > 0.0 {
-        sp.radius
-    } else {
-        start_radius(scene, params.photons)
-    };
-    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-    let mut stats = vec![
-        Stats {
-            n: 0.0,
-            tau: DVec3::ZERO,
-            r: r0,
-            light: DVec3::ZERO,
+/// SPPM's image being made pass by pass: per pixel, its statistics (`density::sppm`).
+struct Sppm<'a> {
+    run: &'a Run<'a>,
+    params: EmitParams,
+    plan: Plan,
+    r0: f32,
+    stats: Vec<PixelStats>,
+    passes: u32,
+    photons_stored: u64,
+    t0: std::time::Instant,
+}
+
+impl<'a> Sppm<'a> {
+    fn new(run: &'a Run<'a>) -> Result<Sppm<'a>, String> {
+        let scene = run.scene;
+        let s = run.settings;
+        let sp: &SppmSettings = &s.estimate.sppm;
+        let mut params = s.emit.clone();
+        if sp.photons > 0 {
+            params.photons = sp.photons;
+        }
+        // Photons at every diffuse hit, the first one only if no next-event estimation.
+        params.global = true;
+        params.caustic = false;
+        params.store_direct = !sp.direct;
+        let plan = Plan::for_scene(scene, &params)
+            .map_err(|e| format!("{}: {e}", scene.path.display()))?;
+        // No diffuse surface (all black, or only mirrors and glass): a valid scene whose
+        // photon layer is black; the passes still average what the eye sees of the emitters.
+        if !plan.global {
+            print!("{plan}");
+        }
+        let r0 = if sp.radius > 0.0 {
+            sp.radius
+        } else {
+            start_radius(scene, params.photons)
         };
-        w * h
-    ];
-    let alpha = sp.alpha as f64;
-    let t0 = std::time::Instant::now();
-    let mut passes = 0u32;
-    let mut snapshots = Vec::new();
-    let mut photons_stored = 0u64;
-    while passes < sp.passes {
-        let pass = passes as u64;
+        let pixels = (scene.camera.width * scene.camera.height) as usize;
+        Ok(Sppm {
+            run,
+            params,
+            plan,
+            r0,
+            stats: vec![PixelStats::new(r0); pixels],
+            passes: 0,
+            photons_stored: 0,
+            t0: std::time::Instant::now(),
+        })
+    }
+}
+
+impl crate::passes::Progressive for Sppm<'_> {
+    fn done(&self) -> u32 {
+        self.passes
+    }
+
+    fn total(&self) -> u32 {
+        self.run.settings.estimate.sppm.passes
+    }
+
+    fn step(&mut self, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
+        let (run, scene, s) = (self.run, self.run.scene, self.run.settings);
+        let sp = &s.estimate.sppm;
+        let pass = self.passes as u64;
         let points = eye::visible_points(scene, pass, sp.direct, run.threads);
-        let photons = if plan.global {
-            pass_photons(scene, &params, &plan, pass, run.threads())?
+        let photons = if self.plan.global {
+            pass_photons(scene, &self.params, &self.plan, pass, run.threads())?
         } else {
             Vec::new()
         };
-        photons_stored += photons.len() as u64;
+        self.photons_stored += photons.len() as u64;
         let map = PhotonMap::build(photons, IndexKind::KdTree);
+        let est = s.estimate.global;
+        let alpha = sp.alpha as f64;
         // Each pixel's update reads only its own statistics: the same for any thread count.
         eye::on_threads(run.threads, || {
-            stats
+            self.stats
                 .par_iter_mut()
                 .zip(&points)
                 .for_each_init(Vec::new, |scratch, (st, ps)| {
-                    st.light += ps.light.as_dvec3();
+                    st.add_light(ps.light);
                     let Some(vp) = ps.point else {
                         return;
                     };
                     let e = map.irradiance_within(vp.p, vp.n, st.r, &est, scratch);
-                    let m = scratch.len() as f64;
-                    if m == 0.0 {
-                        return;
-                    }
-                    let n_new = st.n + alpha * m;
-                    let r_new = st.r as f64 * (n_new / (st.n + m)).sqrt();
-                    let r2 = (st.r as f64).powi(2);
-                    let phi = (vp.weight * e).as_dvec3() * (std::f64::consts::PI * r2);
-                    st.tau = (st.tau + phi) * (r_new * r_new / r2);
-                    st.n = n_new;
-                    st.r = r_new as f32;
+                    st.update(scratch.len(), e, vp.weight, alpha);
                 });
         });
-        passes += 1;
-        progress((w * h) as u64);
-        let elapsed = t0.elapsed().as_secs_f64();
+        self.passes += 1;
+        let passes = self.passes;
+        progress(self.stats.len() as u64);
+        let elapsed = self.t0.elapsed().as_secs_f64();
         // Passes left: to the count, or to the time budget if that comes first.
         let left = (sp.passes - passes) as f64 * elapsed / passes as f64;
         let left = s.time.map_or(left, |t| left.min((t - elapsed).max(0.0)));
         eprintln!(
             "sppm pass {passes}/{}: {elapsed:.2} s, {:.3} M photon paths/s, about {left:.1} s left",
             sp.passes,
-            (passes as u64 * params.photons) as f64 / elapsed / 1e6
+            (passes as u64 * self.params.photons) as f64 / elapsed / 1e6
         );
-        if passes.is_power_of_two() || passes == sp.passes {
-            snapshots.push(Snapshot {
-                passes,
-                seconds: elapsed,
-                layers: layers(&stats, passes, w, h, params.photons, sp.direct),
-            });
+        Ok(())
+    }
+
+    fn layers(&self) -> Vec<Layer> {
+        let scene = self.run.scene;
+        layers(
+            &self.stats,
+            self.passes,
+            scene.camera.width as usize,
+            scene.camera.height as usize,
+            self.params.photons,
+            self.run.settings.estimate.sppm.direct,
+        )
+    }
+
+    fn finish(&self, _seconds: f64) -> Rendered {
+        let sp = &self.run.settings.estimate.sppm;
+        let seconds = self.t0.elapsed().as_secs_f64();
+        let passes = self.passes;
+        let mut info = serde_json::Map::new();
+        let stats = &self.stats;
+        let r_mean = stats.iter().map(|st| st.r as f64).sum::<f64>() / stats.len().max(1) as f64;
+        for (k, v) in [
+            ("sppm", serde_json::json!(sp)),
+            ("sppm_passes", passes.into()),
+            ("sppm_start_radius", self.r0.into()),
+            ("sppm_mean_final_radius", r_mean.into()),
+            ("sppm_photons_per_pass", self.params.photons.into()),
+            ("sppm_photons_stored", self.photons_stored.into()),
+            (
+                "global_estimate",
+                serde_json::json!(self.run.settings.estimate.global),
+            ),
+            ("time_sppm_s", seconds.into()),
+            (
+                "photons_per_s",
+                ((passes as u64 * self.params.photons) as f64 / seconds).into(),
+            ),
+        ] {
+            info.insert(k.to_string(), v);
         }
-        if s.time.is_some_and(|t| elapsed >= t) {
-            break;
+        Rendered {
+            plan: Some(self.plan.clone()),
+            passes: Some(passes),
+            ..Rendered::new(self.layers(), info)
         }
     }
-    let seconds = t0.elapsed().as_secs_f64();
-    let mut info = serde_json::Map::new();
-    let r_mean = stats.iter().map(|st| st.r as f64).sum::<f64>() / stats.len().max(1) as f64;
-    for (k, v) in [
-        ("sppm", serde_json::json!(sp)),
-        ("sppm_passes", passes.into()),
-        ("sppm_start_radius", r0.into()),
-        ("sppm_mean_final_radius", r_mean.into()),
-        ("sppm_photons_per_pass", params.photons.into()),
-        ("sppm_photons_stored", photons_stored.into()),
-        ("global_estimate", serde_json::json!(est)),
-        ("time_sppm_s", seconds.into()),
-        (
-            "photons_per_s",
-            ((passes as u64 * params.photons) as f64 / seconds).into(),
-        ),
-    ] {
-        info.insert(k.to_string(), v);
-    }
-    let layers = layers(&stats, passes, w, h, params.photons, sp.direct);
-    Ok(Rendered {
-        layers,
-        plan: Some(plan),
-        info,
-        passes: Some(passes),
-        samples: None,
-        snapshots,
-    })
+}
+
+pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
+    let mut sppm = Sppm::new(run)?;
+    crate::passes::run(&mut sppm, run.settings.time, progress)
 }
 
 /// The image after `passes` passes: `light` (emission, and direct light when estimated at
 /// the visible points) and `photons` (everything else), each a mean over passes.
 fn layers(
-    stats: &[Stats],
+    stats: &[PixelStats],
     passes: u32,
     w: usize,
     h: usize,
     per_pass: u64,
     direct: bool,
 ) -> Vec<Layer> {
-    let j = passes.max(1) as f64;
     let light = film::Image::from_fn(w, h, |x, y| {
-        (stats[y * w + x].light / j).as_vec3().to_array()
+        stats[y * w + x].light_radiance(passes).to_array()
     });
     let photons = film::Image::from_fn(w, h, |x, y| {
-        let st = &stats[y * w + x];
-        let area = std::f64::consts::PI * (st.r as f64).powi(2);
-        let v: Vec3 = if area > 0.0 {
-            (st.tau / (j * area)).as_vec3()
-        } else {
-            Vec3::ZERO
-        };
-        v.to_array()
+        stats[y * w + x].photon_radiance(passes).to_array()
     });
     vec![
         Layer {
