@@ -189,6 +189,12 @@ pub fn accuracy(
         "final-gather".into(),
         ladder("final-gather", Method::FinalGather, &[1, 2, 4, 8, 16], stop)?,
     ));
+    // The global map shown directly: its bias stays at any budget (which is why `estimate`
+    // defaults to final gathering).
+    table.push((
+        "global-direct".into(),
+        ladder("global-direct", Method::GlobalDirect, &[1, 4, 16], stop)?,
+    ));
     // SPPM: one run, its snapshots are the ladder.
     let out = dir.join("sppm");
     let (seconds, relmse) = run_one(

@@ -7,7 +7,6 @@
 use density::Kernel;
 use film::{Image, Mask};
 use glam::Vec3;
-use render::settings::kernel_name;
 use render::{Overrides, Photons, RenderRequest};
 use scene::{Material, Scene};
 use std::fmt::Write as _;
@@ -319,7 +318,7 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
             md,
             "| [{n}]({n}/image.png) | {} | {} | {} | {secs:.2} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} |",
             v.title,
-            kernel_name(v.kernel),
+            v.kernel.to_string(),
             v.topo.map_or("off".to_string(), |e| format!("eps = {e}"))
                 + if v.boundary {
                     ", boundary corrected"

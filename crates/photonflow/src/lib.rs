@@ -10,6 +10,7 @@ mod composite;
 mod paths;
 
 use clap::{Parser, Subcommand};
+use render::settings::Knob;
 use render::{Overrides, Photons, RenderRequest};
 use scene::{Method, Scene};
 use std::path::{Path, PathBuf};
@@ -104,8 +105,7 @@ enum Cmd {
     /// `final-gather` chain trace (or reuse the cached photons) → estimate → composite.
     Render {
         scene: PathBuf,
-        /// path, global-direct, final-gather, caustic-splat, path+splat or sppm (default: the
-        /// scene's render.method, whose default is sppm).
+        /// The method; its help is drawn from the method table (`command`).
         #[arg(long)]
         method: Option<Method>,
         #[command(flatten)]
@@ -125,8 +125,7 @@ enum Cmd {
     /// Estimate an image from cached photon sets (never traces).
     Estimate {
         scene: PathBuf,
-        /// global-direct (the global map shown directly) or final-gather (default: the
-        /// scene's render.method when it is one of these, else global-direct).
+        /// A method that reads photon maps; its help is drawn from the method table.
         #[arg(long)]
         method: Option<Method>,
         #[command(flatten)]
@@ -290,9 +289,9 @@ struct PhotonArgs {
     /// Nearest photons per global-map estimate (default: [estimate.global] k, else 1000).
     #[arg(long)]
     k: Option<usize>,
-    /// Kernel of the global-map estimate: uniform, silverman, epanechnikov, triweight,
-    /// gaussian, gaussian-jensen, cone, cone:K.
-    #[arg(long, value_parser = render::settings::parse_kernel)]
+    /// Kernel of the global-map estimate, by the scene file's `kind` names: uniform, cone,
+    /// cone:K, gaussian, gaussian_jensen, epanechnikov, silverman, triweight.
+    #[arg(long, value_parser = <density::Kernel as std::str::FromStr>::from_str)]
     kernel: Option<density::Kernel>,
     /// Topological test: keep photons whose direction from the estimation point is within
     /// |cos| < EPS of the tangent plane.
@@ -402,6 +401,58 @@ fn parse_rect(s: &str) -> Result<[usize; 4], String> {
     <[usize; 4]>::try_from(v).map_err(|_| "expected x0,y0,x1,y1".to_string())
 }
 
+/// The command line, with `--method`'s help drawn from the method table (each method's
+/// line, and the default the scene file falls back on), so it never lists another set.
+pub fn command() -> clap::Command {
+    use clap::CommandFactory;
+    let methods = render::methods::help()
+        .lines()
+        .map(|l| format!("  {l}"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let render_help = format!(
+        "The method (default: the scene's render.method, else {}):\n{methods}",
+        Method::default()
+    );
+    let maps: Vec<String> = render::methods::METHODS
+        .iter()
+        .filter(|r| r.reads_photon_maps())
+        .map(|r| r.method.name())
+        .collect();
+    let estimate_help = format!(
+        "{} (default: the scene's render.method when it is one of these, else {})",
+        maps.join(" or "),
+        render::methods::ESTIMATE_DEFAULT
+    );
+    // Where `--spp` and `--passes` go, per method, from the table.
+    let knob_help = |what: &str, knob: fn(&render::methods::MethodRow) -> Option<Knob>| {
+        let places: Vec<String> = render::methods::METHODS
+            .iter()
+            .map(|r| match knob(r) {
+                Some(k) => format!("{}: {}", r.method, k.key()),
+                None => format!("{}: refused", r.method),
+            })
+            .collect();
+        format!("{what} (default: the scene file's; {})", places.join(", "))
+    };
+    let spp_help = knob_help("Samples per pixel", |r| r.spp);
+    let passes_help = knob_help(
+        "Passes of the progressive methods (a run stopped by --time records those made)",
+        |r| r.passes,
+    );
+    Cli::command()
+        .mut_subcommand("render", |c| {
+            c.mut_arg("method", |a| a.help(render_help))
+                .mut_arg("spp", |a| a.help(spp_help.clone()))
+                .mut_arg("passes", |a| a.help(passes_help.clone()))
+        })
+        .mut_subcommand("estimate", |c| {
+            c.mut_arg("method", |a| a.help(estimate_help))
+                .mut_arg("spp", |a| a.help(spp_help.clone()))
+                .mut_arg("passes", |a| a.help(passes_help.clone()))
+        })
+}
+
 /// Runs the command line `args` (the program name first) as the binary does. Returns the exit
 /// code and, for a failure, the one line the binary prints on stderr (not printed here):
 /// 2 for a usage error, 1 for a command that fails. Help and version go to stdout (exit 0).
@@ -410,7 +461,10 @@ where
     I: IntoIterator<Item = T>,
     T: Into<std::ffi::OsString> + Clone,
 {
-    let cli = match Cli::try_parse_from(args) {
+    let parsed = command()
+        .try_get_matches_from(args)
+        .and_then(|m| <Cli as clap::FromArgMatches>::from_arg_matches(&m));
+    let cli = match parsed {
         Ok(c) => c,
         Err(e) => {
             use clap::error::ErrorKind;
@@ -514,10 +568,10 @@ fn run(cmd: Cmd) -> Result<(), String> {
                 ));
             }
             let s = load(&scene, photon.seed)?;
-            // A scene whose default reads no photon maps still gets a photon method here.
+            // A scene whose method reads no photon maps gets the best photon-map method.
             let method = method.unwrap_or(match s.render().method {
                 m if reads_maps(m) => m,
-                _ => Method::GlobalDirect,
+                _ => render::methods::ESTIMATE_DEFAULT,
             });
             let overrides = photon.overrides(Some(method), image.spp);
             let out = out_dir(&s, &overrides, &photon, image.out);

@@ -487,39 +487,3 @@ fn parse_estimate(t: &toml::Table) -> Result<EstimateSettings, String> {
         .try_into()
         .map_err(|e| format!("[estimate]: {e}"))
 }
-
-/// A kernel as the command line spells it (`--kernel`); the scene file uses
-/// `kernel = { kind = "silverman" }` (serde).
-pub fn parse_kernel(s: &str) -> Result<Kernel, String> {
-    Ok(match s {
-        "uniform" | "box" => Kernel::Uniform,
-        "silverman" | "simpson" => Kernel::Silverman,
-        "epanechnikov" => Kernel::Epanechnikov,
-        "triweight" => Kernel::Triweight,
-        "gaussian" => Kernel::Gaussian,
-        "gaussian-jensen" => Kernel::GaussianJensen,
-        "cone" => Kernel::Cone { k: 1.0 },
-        _ => match s.strip_prefix("cone:").map(str::parse::<f32>) {
-            Some(Ok(k)) if k >= 1.0 && k.is_finite() => Kernel::Cone { k },
-            _ => {
-                return Err(format!(
-                    "unknown kernel `{s}` (uniform, silverman, epanechnikov, triweight, gaussian, \
-                     gaussian-jensen, cone, cone:K with K >= 1)"
-                ));
-            }
-        },
-    })
-}
-
-/// The name [`parse_kernel`] reads back.
-pub fn kernel_name(k: Kernel) -> String {
-    match k {
-        Kernel::Uniform => "uniform".into(),
-        Kernel::Silverman => "silverman".into(),
-        Kernel::Epanechnikov => "epanechnikov".into(),
-        Kernel::Triweight => "triweight".into(),
-        Kernel::Gaussian => "gaussian".into(),
-        Kernel::GaussianJensen => "gaussian-jensen".into(),
-        Kernel::Cone { k } => format!("cone:{k}"),
-    }
-}

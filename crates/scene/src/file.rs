@@ -192,7 +192,7 @@ impl Default for RenderSettings {
             rr_depth: 5,
             sampler: SamplerKind::Sobol,
             tile: 16,
-            method: Method::FinalGather,
+            method: Method::default(),
             caustics: true,
         }
     }

@@ -305,6 +305,12 @@ pub static METHODS: [MethodRow; 6] = [
 const PHOTON_MAP_SHARDS: &str = "the photon-map methods estimate from one photon map: shard \
     `trace`, `merge` its photon sets into the cache, then `estimate`";
 
+/// What `estimate` runs when the scene's method reads no photon maps: of the methods that
+/// read them, the one `cargo xtask bench accuracy` measured to reach the 256-spp path
+/// tracer's error (in 0.12x its time on the worksheet scene, `docs/benchmarks.md`); the global
+/// map shown directly keeps its density estimate's bias at any budget.
+pub const ESTIMATE_DEFAULT: Method = Method::FinalGather;
+
 /// The method's row of [`METHODS`].
 pub fn row(method: Method) -> &'static MethodRow {
     // Every method has its row (tested), so the fallback is never taken.
@@ -500,10 +506,7 @@ pub(crate) fn photon_info(
     put("caustic_photons", count(MapKind::Caustic).into());
     put("global_estimate", serde_json::json!(s.estimate.global));
     put("caustic_estimate", serde_json::json!(s.estimate.caustic));
-    put(
-        "kernel",
-        crate::settings::kernel_name(s.estimate.global.kernel).into(),
-    );
+    put("kernel", s.estimate.global.kernel.to_string().into());
     put("boundary_correction", s.estimate.boundary.into());
     put(
         "trace",
