@@ -18,7 +18,9 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
                       or reuse them when the scene and parameters are unchanged
   estimate SCENE [--method global-direct|final-gather] [--k N] [--kernel K] [--topo EPS]
                  [--boundary] [--drop-kth] [--reference EXR]
-                      estimate from the cached photon sets only (never traces)
+                      estimate from the cached photon sets only (never traces);
+                      without --method: the scene's render.method when it reads photon
+                      maps, else the best of them (default final-gather)
   worksheet [--photons N] [--k N] [--topo EPS] [--reference-spp N]
                       worksheet 7's images (box kernel, Silverman, + topological test,
                       + boundary correction) with errors against a path-traced reference,
