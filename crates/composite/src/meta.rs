@@ -294,6 +294,9 @@ impl Meta {
         }
         m.insert("layers".into(), Value::Object(layers));
         m.insert("layer_counts".into(), Value::Object(counts));
+        if let Some(seed) = self.seed {
+            m.insert("seed".into(), json!(seed));
+        }
         Value::Object(m)
     }
 }

@@ -78,45 +78,56 @@ pub fn write(
         }));
         snapshot_images.push((file, img));
     }
-    let mut json = serde_json::json!({
-        "scene": scene.path.display().to_string(),
-        "scene_hash": format!("{:016x}", scene.content_hash),
-        "image_hash": format!("{:016x}", scene.image_hash),
-        "photon_hash": format!("{:016x}", scene.photon_hash),
-        "view_hash": format!("{:016x}", scene.view_hash),
-        "settings_hash": format!("{:016x}", settings.hash(scene)),
-        "method": settings.method.name(),
-        "label": o.label,
-        "seed": scene.seed(),
-        "width": image.width,
-        "height": image.height,
-        "layers": r.layers.iter().map(|l| (l.name.clone(), serde_json::json!(l.classes.iter().map(|c| c.name()).collect::<Vec<_>>())))
-            .collect::<serde_json::Map<_, _>>(),
-        "layer_counts": r.layers.iter()
-            .map(|l| (l.name.clone(), serde_json::json!({
-                "count": l.count,
-                "count_kind": l.count_kind.name(),
-            })))
-            .collect::<serde_json::Map<_, _>>(),
-        "threads": o.threads,
-        "time_total_s": o.seconds,
-        "tone_map": { "gamma": tone.gamma, "exposure": tone.exposure },
-        "reference": o.reference.map(|(p, _)| p.display().to_string()),
-        "rmse": metrics.as_ref().map(|m| m.rmse),
-        "relmse": metrics.as_ref().map(|m| m.relmse),
-        "mae": metrics.as_ref().map(|m| m.mae),
-        "mean": metrics.as_ref().map(|m| m.mean_a),
-        "mean_reference": metrics.as_ref().map(|m| m.mean_b),
-    });
+    // The compositing contract first, through the type that reads it back; then the run's
+    // facts beside it.
+    let meta = composite::Meta {
+        view_hash: format!("{:016x}", scene.view_hash),
+        width: image.width,
+        height: image.height,
+        layers: r
+            .layers
+            .iter()
+            .map(|l| composite::LayerMeta {
+                name: l.name.clone(),
+                classes: l.classes.clone(),
+                count: l.count as f64,
+                count_kind: l.count_kind,
+            })
+            .collect(),
+        seed: Some(scene.seed()),
+    };
+    meta.validate()
+        .map_err(|e| format!("{}: the run's layers: {e}", o.out.display()))?;
+    let mut json = meta.to_json();
     if let Some(obj) = json.as_object_mut() {
-        // One count for the whole run where every layer shares it (composite reads either).
-        if let Some(first) = r.layers.first()
-            && r.layers
-                .iter()
-                .all(|l| (l.count, l.count_kind) == (first.count, first.count_kind))
-        {
-            obj.insert("count".into(), first.count.into());
-            obj.insert("count_kind".into(), first.count_kind.name().into());
+        for (k, v) in [
+            ("scene", scene.path.display().to_string().into()),
+            ("scene_hash", format!("{:016x}", scene.content_hash).into()),
+            ("image_hash", format!("{:016x}", scene.image_hash).into()),
+            ("photon_hash", format!("{:016x}", scene.photon_hash).into()),
+            (
+                "settings_hash",
+                format!("{:016x}", settings.hash(scene)).into(),
+            ),
+            ("method", settings.method.name().into()),
+            ("label", o.label.into()),
+            ("threads", o.threads.into()),
+            ("time_total_s", o.seconds.into()),
+            (
+                "tone_map",
+                serde_json::json!({ "gamma": tone.gamma, "exposure": tone.exposure }),
+            ),
+            (
+                "reference",
+                o.reference.map(|(p, _)| p.display().to_string()).into(),
+            ),
+            ("rmse", metrics.as_ref().map(|m| m.rmse).into()),
+            ("relmse", metrics.as_ref().map(|m| m.relmse).into()),
+            ("mae", metrics.as_ref().map(|m| m.mae).into()),
+            ("mean", metrics.as_ref().map(|m| m.mean_a).into()),
+            ("mean_reference", metrics.as_ref().map(|m| m.mean_b).into()),
+        ] {
+            obj.insert(k.to_string(), v);
         }
         for (k, v) in &r.info {
             obj.insert(k.clone(), v.clone());
