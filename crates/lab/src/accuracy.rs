@@ -6,7 +6,7 @@
 use render::methods::Photons;
 use render::{Overrides, RenderRequest};
 use scene::{Method, Scene};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 /// One rung of a method's ladder: its budget, wall seconds and relative MSE.
@@ -55,39 +55,6 @@ fn time_to(target: f64, rungs: &[Rung]) -> Option<f64> {
         prev = Some(r);
     }
     None
-}
-
-/// The reference of `bench accuracy` and `evidence`: `given`, or a `spp`-sample path-traced
-/// image of the scene cached under `dir` by the scene's view hash (rendered once).
-pub(crate) fn reference(
-    scene: &Scene,
-    given: Option<&Path>,
-    spp: u32,
-    dir: &Path,
-) -> Result<PathBuf, String> {
-    if let Some(p) = given {
-        // Checked now, before any rung writes a run directory.
-        render::read_reference(scene, p)?;
-        return Ok(p.to_path_buf());
-    }
-    let cached = dir.join(format!("reference-{:016x}-{spp}spp", scene.view_hash));
-    let exr = cached.join("image.exr");
-    if exr.is_file() && cached.join("image.json").is_file() {
-        println!("reference: {} (cached)", exr.display());
-        return Ok(exr);
-    }
-    println!("reference: rendering {spp} spp into {}", cached.display());
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    run_one(
-        scene,
-        Method::Path,
-        Some(spp),
-        None,
-        &cached,
-        None,
-        &dir.join("cache-ref"),
-    )?;
-    Ok(exr)
 }
 
 /// One `render` command, timed; returns (seconds, relmse against `reference`).
@@ -140,7 +107,8 @@ pub fn accuracy(
     dir: &Path,
 ) -> Result<(), String> {
     let scene = Scene::load(path).map_err(|e| e.to_string())?;
-    let reference = reference(&scene, given_reference, reference_spp, dir)?;
+    let reference =
+        crate::reference::reference(&scene, given_reference, reference_spp, dir, None)?.exr;
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let cache = dir.join("cache");
     let mut table: Vec<(String, Vec<Rung>)> = Vec::new();

@@ -6,12 +6,11 @@
 //! biased and where it is noisy. Regions come from the scene's geometry (camera rays through
 //! pixel centres), not from hand-drawn boxes.
 
-use crate::worksheet;
 use density::Kernel;
 use film::{BiasVariance, Image, Mask};
 use render::methods::{Photons, Rendered, Run};
 use render::{Overrides, Settings};
-use scene::{Material, Method, Scene};
+use scene::{Method, Scene};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -178,51 +177,6 @@ pub fn techniques(quick: bool) -> Vec<Technique> {
     ]
 }
 
-/// The named regions of an image of `scene`, from its geometry: the caustic under the glass
-/// sphere, the inner edges and corners of the box, its outer rim (the open front), the glass
-/// sphere, the open walls (diffuse surfaces away from edges and caustics), and the whole
-/// image.
-pub fn regions(scene: &Scene) -> Vec<(&'static str, Mask)> {
-    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-    let caustic = worksheet::caustic_region(scene, 1.6);
-    // Edge band: two percent of the scene's diagonal (the k-NN discs' scale).
-    let b = scene.geometry.bounds();
-    let band = 0.02 * (b.max - b.min).length();
-    let rim = worksheet::rim_mask(scene, band);
-    let inner = worksheet::edge_mask(scene, band);
-    let edges = Mask::from_fn(w, h, |x, y| {
-        inner.pixels[y * w + x] && !rim.pixels[y * w + x]
-    });
-    let seen = |x: usize, y: usize| {
-        scene
-            .geometry
-            .intersect(&scene.camera.ray(x as f32 + 0.5, y as f32 + 0.5))
-    };
-    let glass = Mask::from_fn(w, h, |x, y| {
-        seen(x, y).is_some_and(|hit| {
-            matches!(
-                scene.materials[hit.material as usize],
-                Material::Dielectric { .. }
-            )
-        })
-    });
-    let walls = Mask::from_fn(w, h, |x, y| {
-        let i = y * w + x;
-        !caustic.pixels[i]
-            && !inner.pixels[i]
-            && !rim.pixels[i]
-            && seen(x, y).is_some_and(|hit| scene.is_diffuse(hit.material))
-    });
-    vec![
-        ("image", Mask::all(w, h)),
-        ("caustic", caustic),
-        ("edges and corners", edges),
-        ("outer rim", rim),
-        ("glass sphere", glass),
-        ("open walls", walls),
-    ]
-}
-
 /// Mean errors of a rung's runs over one region: relative MSE as `(v - r)² / (r² + 0.01)`
 /// and as pbrt's `(v - r)² / (r + 0.01)²`, RMSE, the ratio of the means (`film::metrics` of
 /// each run) and LDR-FLIP (`film::flip`), each averaged over the runs.
@@ -372,7 +326,14 @@ pub struct Reference {
 }
 
 fn reference(scene: &Scene, a: &EvidenceArgs) -> Result<Reference, String> {
-    let path = crate::accuracy::reference(scene, a.reference.as_deref(), a.reference_spp, &a.out)?;
+    let path = crate::reference::reference(
+        scene,
+        a.reference.as_deref(),
+        a.reference_spp,
+        &a.out,
+        a.threads,
+    )?
+    .exr;
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let read = |p: &Path| -> Result<Image, String> {
         let img = film::read_exr(p).map_err(|e| e.to_string())?;
@@ -441,7 +402,7 @@ pub fn run(a: &EvidenceArgs) -> Result<Measured, String> {
     // Nothing is written before the reference is known to be usable (a given one is read
     // and checked first; a cached one is rendered into `out`, which it creates).
     let reference = reference(&scene, a)?;
-    let regions = regions(&scene);
+    let regions = crate::regions::regions(&scene);
     let caustic_regions: Vec<(&'static str, Mask)> = regions
         .iter()
         .filter(|(n, _)| matches!(*n, "image" | "caustic"))

@@ -8,6 +8,8 @@ pub mod accuracy;
 pub mod bench;
 pub mod evidence;
 pub mod plots;
+pub mod reference;
+pub mod regions;
 pub mod report;
 pub mod worksheet;
 

@@ -10,7 +10,7 @@ fn cornell() -> scene::Scene {
 
 #[test]
 fn point_triangle_distance_matches_a_dense_search() {
-    use crate::worksheet::distance_for_test;
+    use crate::regions::distance_for_test;
     use glam::Vec3;
     let mut rng = math::Rng::new(5);
     let mut v = || Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 4.0 - 2.0;
@@ -37,7 +37,7 @@ fn point_triangle_distance_matches_a_dense_search() {
 #[test]
 fn the_edge_mask_marks_the_inner_edges_only() {
     let s = cornell();
-    let m = crate::worksheet::edge_mask(&s, 0.4);
+    let m = crate::regions::edge_mask(&s, 0.4);
     let share = m.count() as f64 / m.pixels.len() as f64;
     // A band of 0.4 along the box's inner edges covers a modest share of the image.
     assert!(share > 0.03 && share < 0.3, "{share}");
@@ -51,7 +51,7 @@ fn the_rim_mask_marks_the_open_front_only() {
     let s = cornell();
     let b = s.geometry.bounds();
     let band = 0.02 * (b.max - b.min).length();
-    let m = crate::worksheet::rim_mask(&s, band);
+    let m = crate::regions::rim_mask(&s, band);
     let (w, h) = (m.width, m.height);
     assert!(m.count() > 500, "{} rim pixels", m.count());
     // The box's open side faces the camera (at +z): every rim pixel sees a point within the

@@ -6,9 +6,8 @@
 
 use density::Kernel;
 use film::{Image, Mask};
-use glam::Vec3;
 use render::{Overrides, Photons, RenderRequest};
-use scene::{Material, Scene};
+use scene::Scene;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -53,37 +52,9 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
     std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
 
     // 1. The path-traced reference, reused when it was made with exactly these settings.
-    let ref_dir = a.out.join("reference");
+    let r = crate::reference::reference(scene, None, a.reference_spp, &a.out, a.threads)?;
+    let ref_dir = r.run.unwrap_or_else(|| a.out.clone());
     let reference_json = ref_dir.join("image.json");
-    let reference_overrides = Overrides {
-        method: Some(scene::Method::Path),
-        spp: Some(a.reference_spp),
-        caustics: Some(true),
-        ..Overrides::default()
-    };
-    let want = render::Settings::new(scene, &reference_overrides)?.hash(scene);
-    let reusable = std::fs::read_to_string(&reference_json)
-        .ok()
-        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-        .is_some_and(|j| j["settings_hash"] == format!("{want:016x}"));
-    if reusable {
-        println!("reference: reusing {}", ref_dir.display());
-    } else {
-        println!("reference: path tracing at {} spp", a.reference_spp);
-        render::render(
-            scene,
-            &RenderRequest {
-                overrides: reference_overrides,
-                cache: &a.cache,
-                photons: Photons::CacheOnly,
-                threads: a.threads,
-                out: ref_dir.clone(),
-                exposure: 0.0,
-                reference: None,
-                label: None,
-            },
-        )?;
-    }
     let reference = film::read_exr(ref_dir.join("image.exr")).map_err(|e| e.to_string())?;
     let ref_meta: serde_json::Value = std::fs::read_to_string(&reference_json)
         .ok()
@@ -160,7 +131,7 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
         },
     ];
     let (w, h) = (reference.width, reference.height);
-    let edges = edge_mask(scene, 0.4);
+    let edges = crate::regions::edge_mask(scene, 0.4);
     // Metrics at 1/DOWN resolution: each compared pixel then averages DOWN^2 reference
     // pixels, so the reference's fireflies (caustic paths the path tracer finds rarely) stop
     // dominating every RMSE.
@@ -211,7 +182,7 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
     // 4. Caustics: the k-NN caustic map (inside final gathering) against photon differential
     // splatting, alone and with the rest path-traced; errors of the caustic layer against
     // the reference's in the region around the glass sphere's caustic.
-    let caustic_mask = caustic_region(scene, 1.6);
+    let caustic_mask = crate::regions::caustic_region(scene, 1.6);
     let reference_caustic =
         film::read_exr(ref_dir.join("layers").join("caustic.exr")).map_err(|e| e.to_string())?;
     // Splatting is cheap per photon (no map, no k-NN): it gets 20x the paths.
@@ -298,13 +269,16 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
     );
     let _ = writeln!(
         md,
-        "Errors are against a path-traced reference (`reference/image.png`, {} spp, {:.0} s), \
+        "Errors are against a path-traced reference (`{}/image.png`, {} spp, {:.0} s), \
          measured on both images box-filtered 4x4 (128x128 pixels, so each compared pixel \
          holds 16x the reference's samples and its fireflies no longer dominate): RMSE and \
          relative MSE over the whole image, RMSE and mean ratio inside the band within 0.4 \
          units of the box's inner edges (`edge-mask.png`; corners, where topological and \
          boundary bias show), and MAE at full resolution. The reference's own noise still \
          adds a floor to each RMSE: compare the rows with each other.\n",
+        ref_dir
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
         ref_meta["spp"].as_u64().unwrap_or(a.reference_spp as u64),
         ref_meta["time_render_s"].as_f64().unwrap_or(0.0)
     );
@@ -464,160 +438,4 @@ one final-gather bounce.";
 /// The caustic map's k from the scene's `[estimate.caustic]`.
 fn settings_caustic_k(scene: &Scene) -> usize {
     render::Settings::new(scene, &Overrides::default()).map_or(250, |s| s.estimate.caustic.k)
-}
-
-/// Pixels whose camera ray (through the pixel centre) lands on the floor (a diffuse surface
-/// facing up) within `radii` sphere radii, horizontally, of a glass sphere's centre: where
-/// its caustic falls.
-pub fn caustic_region(scene: &Scene, radii: f32) -> Mask {
-    let cam = &scene.camera;
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    let glass: Vec<(Vec3, f32)> = scene
-        .geometry
-        .spheres()
-        .iter()
-        .filter(|s| {
-            matches!(
-                scene.materials[s.material as usize],
-                Material::Dielectric { .. }
-            )
-        })
-        .map(|s| (s.center, s.radius))
-        .collect();
-    Mask::from_fn(w, h, |x, y| {
-        let ray = cam.ray(x as f32 + 0.5, y as f32 + 0.5);
-        let Some(hit) = scene.geometry.intersect(&ray) else {
-            return false;
-        };
-        if !scene.is_diffuse(hit.material) || hit.point.n.y.abs() < 0.99 {
-            return false;
-        }
-        let p = hit.point.p;
-        glass.iter().any(|&(c, r)| {
-            let d = Vec3::new(p.x - c.x, 0.0, p.z - c.z).length();
-            p.y < c.y && d < radii * r
-        })
-    })
-}
-
-/// Pixels whose camera ray (through the pixel centre) lands on a diffuse surface within
-/// `band` of a triangle that is not coplanar with it: the inner edges and corners of the box.
-pub fn edge_mask(scene: &Scene, band: f32) -> Mask {
-    let cam = &scene.camera;
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    let mesh = scene.geometry.mesh();
-    let walls: Vec<usize> = (0..mesh.len())
-        .filter(|&t| {
-            matches!(
-                scene.materials[mesh.materials[t] as usize],
-                Material::Lambertian { .. }
-            )
-        })
-        .collect();
-    Mask::from_fn(w, h, |x, y| {
-        let Some(hit) = scene
-            .geometry
-            .intersect(&cam.ray(x as f32 + 0.5, y as f32 + 0.5))
-        else {
-            return false;
-        };
-        if !matches!(
-            scene.materials[hit.material as usize],
-            Material::Lambertian { .. }
-        ) {
-            return false;
-        }
-        walls.iter().any(|&t| {
-            let n = mesh.face_normal(t).normalize_or_zero();
-            n.dot(hit.point.n).abs() < 0.9
-                && point_triangle_distance(hit.point.p, mesh.vertices(t)) < band
-        })
-    })
-}
-
-/// Pixels whose camera ray lands on a diffuse surface within `band` of the box's outer rim:
-/// an edge of a diffuse triangle that no other triangle touches (the open front of the box),
-/// where a density estimate's disc reaches past the surface (boundary bias). Edges are tested
-/// at their midpoints against every triangle: quadratic in the triangle count, which suits
-/// boxes, not million-triangle meshes.
-pub fn rim_mask(scene: &Scene, band: f32) -> Mask {
-    let cam = &scene.camera;
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    let mesh = scene.geometry.mesh();
-    let b = scene.geometry.bounds();
-    let eps = 1e-5 * (b.max - b.min).length();
-    let mut rim: Vec<(Vec3, Vec3)> = Vec::new();
-    for t in 0..mesh.len() {
-        if !scene.is_diffuse(mesh.materials[t]) {
-            continue;
-        }
-        let v = mesh.vertices(t);
-        for i in 0..3 {
-            let (a, c) = (v[i], v[(i + 1) % 3]);
-            let mid = 0.5 * (a + c);
-            let touched = (0..mesh.len())
-                .any(|u| u != t && point_triangle_distance(mid, mesh.vertices(u)) < eps);
-            if !touched {
-                rim.push((a, c));
-            }
-        }
-    }
-    Mask::from_fn(w, h, |x, y| {
-        let Some(hit) = scene
-            .geometry
-            .intersect(&cam.ray(x as f32 + 0.5, y as f32 + 0.5))
-        else {
-            return false;
-        };
-        scene.is_diffuse(hit.material)
-            && rim
-                .iter()
-                .any(|&(a, c)| point_segment_distance(hit.point.p, a, c) < band)
-    })
-}
-
-fn point_segment_distance(p: Vec3, a: Vec3, b: Vec3) -> f32 {
-    let ab = b - a;
-    let t = ((p - a).dot(ab) / ab.length_squared().max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
-    (p - (a + t * ab)).length()
-}
-
-/// Distance from `p` to the triangle `t` (Ericson, Real-Time Collision Detection, §5.1.5).
-fn point_triangle_distance(p: Vec3, t: [Vec3; 3]) -> f32 {
-    let [a, b, c] = t;
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return (p - a).length();
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return (p - b).length();
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return (p - (a + ab * (d1 / (d1 - d3)))).length();
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return (p - c).length();
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return (p - (a + ac * (d2 / (d2 - d6)))).length();
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return (p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))))).length();
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let (v, w) = (vb * denom, vc * denom);
-    (p - (a + ab * v + ac * w)).length()
-}
-
-#[cfg(test)]
-pub(crate) fn distance_for_test(p: Vec3, t: [Vec3; 3]) -> f32 {
-    point_triangle_distance(p, t)
 }
