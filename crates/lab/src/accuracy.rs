@@ -3,7 +3,7 @@
 //! only ratios taken together mean anything). Each run is a whole `render` command (photons
 //! traced anew into an empty cache, outputs written), timed from start to finish.
 
-use render::methods::Photons;
+use render::Photons;
 use render::{Overrides, RenderRequest};
 use scene::{Method, Scene};
 use std::path::Path;

@@ -8,8 +8,8 @@
 
 use density::Kernel;
 use film::{BiasVariance, Image, Mask};
-use render::methods::{Photons, Rendered, Run};
 use render::{Overrides, Settings};
+use render::{Photons, Rendered, Run};
 use scene::{Method, Scene};
 use std::path::{Path, PathBuf};
 use std::time::Instant;

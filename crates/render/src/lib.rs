@@ -21,6 +21,8 @@ pub mod maps;
 pub mod methods;
 pub mod output;
 pub mod passes;
+pub mod rendered;
+pub mod run;
 pub mod settings;
 pub mod shard;
 pub mod splat;
@@ -28,7 +30,8 @@ pub mod splat;
 #[cfg(test)]
 mod tests;
 
-pub use methods::{Photons, Rendered, Run};
+pub use rendered::{Layer, Rendered};
+pub use run::{Photons, Run};
 pub use settings::{EstimateSettings, Overrides, Settings};
 
 use flow::Progress;

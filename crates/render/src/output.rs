@@ -4,7 +4,7 @@
 //! can fail (the reference, the settings' serialisation) is checked before the first byte is
 //! written.
 
-use crate::methods::Rendered;
+use crate::rendered::Rendered;
 use crate::settings::Settings;
 use film::{Image, Mask, ToneMap};
 use scene::Scene;

@@ -4,7 +4,7 @@
 //! path tracer) reach a power of two, and after the last, so one run gives an
 //! error-against-time series.
 
-use crate::methods::{Layer, Rendered, Snapshot};
+use crate::rendered::{Layer, Rendered, Snapshot};
 
 /// A method's image being made pass by pass.
 pub trait Progressive {

@@ -1,11 +1,12 @@
 //! Image shards (`render --shard I/N`, `path` and `caustic-splat`) and `merge`. An image shard
-//! renders the blocks of the run ([`crate::methods::Accumulate`]: the path tracer's passes of
+//! renders the blocks of the run ([`crate::run::Accumulate`]: the path tracer's passes of
 //! samples, splatting's passes) that start in the shard's range, and writes each block's f64
 //! sums per pixel; merging adds every block from zero in block order, exactly as the
 //! one-machine run adds them, and writes the same `image.exr` and `layers/`. The shard
 //! directory format and photon shards are `photons::shard`'s.
 
-use crate::methods::{self, Run};
+use crate::methods;
+use crate::run::Run;
 use crate::settings::{Overrides, Settings};
 use composite::shards::cover;
 use flow::Progress;
@@ -135,7 +136,7 @@ fn merge_image(all: &[Input], order: &[usize], out: &Path) -> Result<String, Str
         scene: &scene,
         settings: &settings,
         cache: Path::new("."),
-        photons: methods::Photons::CacheOnly,
+        photons: crate::run::Photons::CacheOnly,
         threads: Some(1),
     };
     let blocks_fn = methods::row(settings.method)

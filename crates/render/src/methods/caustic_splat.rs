@@ -3,7 +3,8 @@
 //! bounces) by photon differential splatting onto eye vertices, with no photon map (the
 //! course framework's `splat_caustics_map`). `[estimate.splat]` holds its knobs.
 
-use super::{CountKind, Layer, Rendered, Run};
+use crate::rendered::{CountKind, Layer, Rendered};
+use crate::run::Run;
 use crate::splat;
 use film::Class;
 
@@ -171,16 +172,16 @@ impl<'a> Progressive<'a> {
 }
 
 /// Splatting's run as blocks: its passes, one block each.
-pub(super) fn blocks<'a>(run: &'a Run<'a>) -> super::Blocks<'a> {
+pub(super) fn blocks<'a>(run: &'a Run<'a>) -> crate::run::Blocks<'a> {
     let passes = run.settings.estimate.splat.passes as u64;
-    super::Blocks {
+    crate::run::Blocks {
         acc: Box::new(Progressive::new(run)),
         blocks: (0..passes).map(|j| j..j + 1).collect(),
         unit: "passes",
     }
 }
 
-impl super::Accumulate for Progressive<'_> {
+impl crate::run::Accumulate for Progressive<'_> {
     fn layer_names(&self) -> Vec<String> {
         Progressive::layer_names(self)
     }
@@ -230,7 +231,7 @@ impl crate::passes::Progressive for Progressive<'_> {
     }
 
     fn finish(&self, seconds: f64) -> Rendered {
-        super::Accumulate::finish(self, seconds)
+        crate::run::Accumulate::finish(self, seconds)
     }
 }
 

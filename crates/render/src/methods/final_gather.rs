@@ -3,13 +3,14 @@
 //! per sample reading the global map, through an irradiance cache precomputed at every
 //! `cache`-th global photon (Christensen 1999; 0 reads the map at every gather hit).
 
-use super::{CountKind, Rendered, Run};
 use crate::gather_cache::IrradianceCache;
+use crate::rendered::{CountKind, Rendered};
+use crate::run::Run;
 use film::Class;
 use store::MapKind;
 
 pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
-    let mut inputs = super::photon_inputs(run, true)?;
+    let mut inputs = crate::run::photon_inputs(run, true)?;
     let fg = run.settings.estimate.final_gather;
     let spp = run.settings.estimate.spp;
     let t_cache = std::time::Instant::now();
@@ -42,7 +43,7 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
         progress,
     );
     let seconds = t0.elapsed().as_secs_f64();
-    let mut info = super::photon_info(run, &inputs);
+    let mut info = crate::run::photon_info(run, &inputs);
     info.insert("gather_rays".into(), fg.rays.into());
     info.insert(
         "gather_cache_stride".into(),
@@ -54,7 +55,7 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
     Ok(Rendered {
         // Emission and next-event estimation use no photons: weighed by samples; the layers
         // read from photon maps by photon paths.
-        layers: super::layers(
+        layers: crate::run::layers(
             &film,
             spp,
             &[

@@ -8,7 +8,8 @@
 //! them), pixel sample `s` drawing what it would in one run of all of them; a time budget
 //! stops after the pass that reaches it and records the samples made.
 
-use super::{CountKind, Layer, Rendered, Run};
+use crate::rendered::{CountKind, Layer, Rendered};
+use crate::run::Run;
 use film::Class;
 use glam::DVec3;
 
@@ -193,15 +194,15 @@ pub(super) fn passes(spp: u32) -> Vec<std::ops::Range<u64>> {
 }
 
 /// The path tracer's run as blocks: its passes ([`passes`]).
-pub(super) fn blocks<'a>(run: &'a Run<'a>) -> super::Blocks<'a> {
-    super::Blocks {
+pub(super) fn blocks<'a>(run: &'a Run<'a>) -> crate::run::Blocks<'a> {
+    crate::run::Blocks {
         acc: Box::new(Progressive::new(run)),
         blocks: passes(run.settings.render.spp),
         unit: "samples per pixel",
     }
 }
 
-impl super::Accumulate for Progressive<'_> {
+impl crate::run::Accumulate for Progressive<'_> {
     fn layer_names(&self) -> Vec<String> {
         Progressive::layer_names(self)
     }
@@ -244,7 +245,7 @@ impl crate::passes::Progressive for Progressive<'_> {
     }
 
     fn finish(&self, seconds: f64) -> Rendered {
-        super::Accumulate::finish(self, seconds)
+        crate::run::Accumulate::finish(self, seconds)
     }
 }
 

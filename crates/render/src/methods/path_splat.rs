@@ -10,7 +10,9 @@
 //! the path tracer's samples are a power of two) or a time budget finds both about equally
 //! far along.
 
-use super::{Layer, Rendered, Run, caustic_splat, path};
+use super::{caustic_splat, path};
+use crate::rendered::{Layer, Rendered};
+use crate::run::Run;
 
 struct PathSplat<'a> {
     image: path::Progressive<'a>,

@@ -13,7 +13,8 @@
 //! shrink so that bias vanishes while the photon count in them still grows, so the error
 //! goes to zero (consistent), unlike a fixed k or radius.
 
-use super::{CountKind, Layer, Rendered, Run};
+use crate::rendered::{CountKind, Layer, Rendered};
+use crate::run::Run;
 use crate::settings::SppmSettings;
 use density::sppm::PixelStats;
 use density::{IndexKind, PhotonMap};
