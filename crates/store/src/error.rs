@@ -1,9 +1,6 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use crate::format::FORMAT_VERSION;
-use crate::format::RECORD_LAYOUT;
-
 /// Why a photon file could not be written, read or used. Its message always starts with the
 /// file's path: the user's next step is to look at (or delete) that file.
 #[derive(Debug)]
@@ -24,12 +21,16 @@ pub enum Problem {
     /// A directory, FIFO, socket or device where a photon file should be (never opened: a
     /// FIFO would block).
     NotRegularFile(&'static str),
+    /// A format version this build does not read (`reads`: the one it does).
     Version {
         found: u32,
+        reads: u32,
     },
+    /// A record layout this build does not read (`reads`: the one it does).
     Layout {
         found: String,
         size: u32,
+        reads: &'static str,
     },
     /// The file ends before `end`; `chunk` is `(index, count)`, or `None` inside the header.
     Truncated {
@@ -72,13 +73,12 @@ impl fmt::Display for Problem {
             Problem::Io { op, error } => write!(f, "cannot {op}: {error}"),
             Problem::NotPhotonFile => write!(f, "not a photon file (bad magic)"),
             Problem::NotRegularFile(what) => write!(f, "not a regular file (it is {what})"),
-            Problem::Version { found } => write!(
+            Problem::Version { found, reads } => {
+                write!(f, "format version {found}, this build reads {reads}")
+            }
+            Problem::Layout { found, size, reads } => write!(
                 f,
-                "format version {found}, this build reads {FORMAT_VERSION}"
-            ),
-            Problem::Layout { found, size } => write!(
-                f,
-                "record layout \"{found}\" ({size} bytes), this build reads \"{RECORD_LAYOUT}\" (32 bytes)"
+                "record layout \"{found}\" ({size} bytes), this build reads \"{reads}\" (32 bytes)"
             ),
             Problem::Truncated {
                 chunk: Some((i, n)),

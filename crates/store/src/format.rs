@@ -238,7 +238,10 @@ pub fn decode_prefix(b: &[u8], len: u64) -> Result<u64, Problem> {
     }
     let version = u32_at(b, 8)?;
     if version != FORMAT_VERSION {
-        return Err(Problem::Version { found: version });
+        return Err(Problem::Version {
+            found: version,
+            reads: FORMAT_VERSION,
+        });
     }
     let header_len = u32_at(b, 12)?;
     let least = (FIXED_LEN + 4).next_multiple_of(32) as u32;
@@ -290,6 +293,7 @@ pub fn decode_header(b: &[u8]) -> Result<(Header, Chunks), Problem> {
         return Err(Problem::Layout {
             found: String::from_utf8_lossy(layout).into_owned(),
             size: record_size,
+            reads: RECORD_LAYOUT,
         });
     }
     let params = String::from_utf8(params.to_vec())

@@ -288,7 +288,7 @@ fn other_format_versions_are_refused() {
         std::fs::write(&path, with_version(&bytes, v)).unwrap();
         for e in refused(&path) {
             assert!(
-                matches!(e.problem, Problem::Version { found } if found == v),
+                matches!(e.problem, Problem::Version { found, .. } if found == v),
                 "{e}"
             );
             let want = format!("format version {v}, this build reads {FORMAT_VERSION}");
