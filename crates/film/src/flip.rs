@@ -38,17 +38,6 @@ impl FlipMap {
         }
         Ok((n > 0).then(|| sum / n as f64))
     }
-
-    /// The map in FLIP's magma colours, for a PNG.
-    pub fn magma(&self) -> Image {
-        let lut = nv_flip::magma_lut().to_vec();
-        Image::from_fn(self.width, self.height, |x, y| {
-            let e = self.map[y * self.width + x].clamp(0.0, 1.0);
-            let i = 3 * ((e * 255.0).round() as usize);
-            // Linear values that the PNG writer's gamma-1 tone map writes back unchanged.
-            [0, 1, 2].map(|c| lut[i + c] as f32 / 255.0)
-        })
-    }
 }
 
 /// The display value of a linear channel: exposure, clamp, gamma 2.2, 8 bits (NaN reads as

@@ -21,18 +21,6 @@ pub trait Sink<T> {
     fn consume(&mut self, chunk: &Arc<T>) -> Result<(), String>;
 }
 
-/// Forwards every chunk to a stage running on its own thread. The channel should be bounded:
-/// the stage then holds the workers back when it falls behind.
-pub struct ChannelSink<T>(pub Sender<Arc<T>>);
-
-impl<T> Sink<T> for ChannelSink<T> {
-    fn consume(&mut self, chunk: &Arc<T>) -> Result<(), String> {
-        self.0
-            .send(Arc::clone(chunk))
-            .map_err(|_| "a stage stopped before its input did".to_string())
-    }
-}
-
 /// What a run of [`run_chunks`] did.
 pub struct Stats {
     /// Indices computed.

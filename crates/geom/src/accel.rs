@@ -53,7 +53,6 @@ pub struct Geometry {
     mesh: TriMesh,
     spheres: Vec<Sphere>,
     accel: Accel,
-    kind: BvhKind,
     /// `CwBvh` only: triangles in BVH leaf order (obvhs' `primitive_indices`), so traversal
     /// reads them contiguously without the extra indirection.
     rt: Vec<RtTriangle>,
@@ -112,7 +111,6 @@ impl Geometry {
             mesh,
             spheres,
             accel,
-            kind,
             rt,
             rt_ids: order,
             bounds,
@@ -129,10 +127,6 @@ impl Geometry {
 
     pub fn bounds(&self) -> Bounds3 {
         self.bounds
-    }
-
-    pub fn bvh_kind(&self) -> BvhKind {
-        self.kind
     }
 
     /// Closest hit with `0 < t < ray.t_max`.

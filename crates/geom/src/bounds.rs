@@ -24,13 +24,6 @@ impl Bounds3 {
         }
     }
 
-    pub fn union(self, b: Bounds3) -> Bounds3 {
-        Bounds3 {
-            min: self.min.min(b.min),
-            max: self.max.max(b.max),
-        }
-    }
-
     pub fn contains(&self, p: Vec3) -> bool {
         p.cmpge(self.min).all() && p.cmple(self.max).all()
     }

@@ -1,5 +1,5 @@
-//! Where traced chunks go: photon files ([`StoreSink`]), memory ([`CollectSink`]), or any
-//! stage behind a channel (`flow::ChannelSink`); [`run`] traces a run through them.
+//! Where traced chunks go: photon files ([`StoreSink`]) or any other `flow::Sink` of traced
+//! chunks; [`run`] traces a run through them.
 
 use emit::{EmitParams, Plan, Traced};
 use flow::{PipelineOptions, Progress, Stats};
@@ -63,18 +63,6 @@ impl flow::Sink<Traced> for StoreSink {
             self.stored[*kind] += photons.len() as u64;
             w.write(photons).map_err(|e| e.to_string())?;
         }
-        Ok(())
-    }
-}
-
-/// Collects every chunk in memory: an in-process consumer (a k-NN builder that needs no
-/// photon file, or a test).
-#[derive(Default)]
-pub struct CollectSink(pub Traced);
-
-impl flow::Sink<Traced> for CollectSink {
-    fn consume(&mut self, chunk: &Arc<Traced>) -> Result<(), String> {
-        self.0.append(Traced::clone(chunk));
         Ok(())
     }
 }

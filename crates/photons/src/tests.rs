@@ -4,9 +4,33 @@
 use crate::cache::{self as pipeline, CacheKey};
 use crate::sinks::{self, Sink, StoreSink};
 use emit::{EmitParams, Plan};
-use flow::{ChannelSink, PipelineOptions, Progress};
+use flow::{PipelineOptions, Progress};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use store::{MapKind, MappedStore};
+
+/// A stage on its own thread behind a bounded channel: the channel holds tracing back when
+/// the stage falls behind.
+struct ChannelSink<T>(crossbeam_channel::Sender<Arc<T>>);
+
+impl<T> flow::Sink<T> for ChannelSink<T> {
+    fn consume(&mut self, chunk: &Arc<T>) -> Result<(), String> {
+        self.0
+            .send(Arc::clone(chunk))
+            .map_err(|_| "a stage stopped before its input did".to_string())
+    }
+}
+
+/// Collects every chunk in memory: an in-process consumer beside the file writer.
+#[derive(Default)]
+struct CollectSink(emit::Traced);
+
+impl flow::Sink<emit::Traced> for CollectSink {
+    fn consume(&mut self, chunk: &Arc<emit::Traced>) -> Result<(), String> {
+        self.0.append(emit::Traced::clone(chunk));
+        Ok(())
+    }
+}
 
 fn cornell() -> scene::Scene {
     let p =
@@ -163,7 +187,6 @@ fn the_cache_reuses_only_identical_runs() {
 fn an_in_memory_stage_sees_the_same_photons_as_the_file_writer() {
     // Two consumers of one run: the photon file writer and an in-memory collector (what a
     // k-NN builder or a splatter does with the chunks). Both see every photon, in order.
-    use crate::sinks::CollectSink;
     let scene = cornell();
     let params = EmitParams {
         photons: 12_000,
