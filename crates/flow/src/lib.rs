@@ -124,3 +124,6 @@ pub fn chunks(total: u64, chunk: u64) -> impl Iterator<Item = std::ops::Range<u6
     let chunk = chunk.max(1);
     (0..total.div_ceil(chunk)).map(move |k| k * chunk..((k + 1) * chunk).min(total))
 }
+
+#[cfg(test)]
+mod tests;
