@@ -478,6 +478,60 @@ mod tests {
         );
     }
 
+    /// The issue tracker is not in the repository: a comment or doc that cites an issue by
+    /// number points nowhere a reader can follow.
+    #[test]
+    fn no_issue_numbers_in_comments_and_docs() {
+        let root = root();
+        let mut problems = Vec::new();
+        for rel in documented_files() {
+            let text = std::fs::read_to_string(root.join(&rel)).unwrap();
+            problems.extend(issue_numbers(&rel, &text));
+        }
+        assert!(
+            problems.is_empty(),
+            "comments and docs cite issues the repository does not hold:\n{}",
+            problems.join("\n")
+        );
+    }
+
+    /// Lines of `text` that cite an issue by number: the word, plural or not, then a number,
+    /// with or without `#`.
+    fn issue_numbers(rel: &Path, text: &str) -> Vec<String> {
+        let mut out = Vec::new();
+        for (i, line) in text.lines().enumerate() {
+            let lower = line.to_lowercase();
+            let mut rest = lower.as_str();
+            while let Some(at) = rest.find("issue") {
+                let word_start = !rest[..at].ends_with(|c: char| c.is_ascii_alphanumeric());
+                let after = rest[at + 5..].trim_start_matches('s');
+                let after = after.trim_start_matches([' ', '#']);
+                if word_start && after.starts_with(|c: char| c.is_ascii_digit()) {
+                    out.push(format!("{}:{}: {}", rel.display(), i + 1, line.trim()));
+                    break;
+                }
+                rest = &rest[at + 5..];
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn issue_numbers_are_found() {
+        let f = |t: &str| issue_numbers(Path::new("a.rs"), t).len();
+        let cited = concat!(
+            "//! Shards (iss",
+            "ue 14): x\n// Iss",
+            "ue #3\n// iss",
+            "ues 4, 5\n"
+        );
+        assert_eq!(f(cited), 3);
+        assert_eq!(
+            f("// a known issue: 12 photons\n// tissue 1\n// an issue, k = 250\n"),
+            0
+        );
+    }
+
     #[test]
     fn dangling_paths_are_found_on_strings() {
         let crates = [PathBuf::from("crates/geom")];
