@@ -5,17 +5,17 @@
 //! what they wrote instead. A case that hangs fails after a timeout; one that panics fails
 //! with the panic.
 //!
-//! Each kind of issue 12's point 1 has cases here: panics, hangs, accepted bad values,
+//! Each kind of bad-input failure has cases here: panics, hangs, accepted bad values,
 //! partial output, messages, valid scenes refused and temporary files (a stale file from a
 //! dead process; Ctrl-C itself needs a process: the binary's own test `cli.rs` signals it).
 //! Every loader (OBJ, MTL, scene file, photon file, EXR) and every command's flags have cases
 //! too (the bench commands only with values refused before any timing starts).
 
+use crate::kit::{TempDir, cli};
 use film::Image;
 use std::path::Path;
 use std::sync::mpsc;
 use std::time::Duration;
-use tests::TempDir;
 
 const CAMERA: &str =
     "[camera]\neye = [0, 1, 3]\nlook_at = [0, 0, 0]\nvfov = 60\nwidth = 16\nheight = 16\n";
@@ -825,7 +825,7 @@ fn cases() -> Vec<Case> {
             words: &[],
             check: present("out/plan.txt", "no surface is diffuse"),
         },
-        // Shards and merge (issue 14): a bad set is refused naming the file, nothing written.
+        // Shards and merge: a bad set is refused naming the file, nothing written.
         Case {
             name: "merge: a shard missing",
             files: good(),
@@ -1037,15 +1037,13 @@ fn cases() -> Vec<Case> {
 
 /// Runs `args` in process on a thread; `None` if it did not return within the timeout.
 fn run(args: &str, dir: &Path) -> Option<std::thread::Result<(u8, Option<String>)>> {
-    let argv: Vec<String> = std::iter::once("photonflow".to_string())
-        .chain(
-            args.split(' ')
-                .map(|a| a.replace("{d}", &dir.display().to_string())),
-        )
+    let argv: Vec<String> = args
+        .split(' ')
+        .map(|a| a.replace("{d}", &dir.display().to_string()))
         .collect();
     let (tx, rx) = mpsc::channel();
     std::thread::spawn(move || {
-        let r = std::panic::catch_unwind(|| photonflow::run_args(argv));
+        let r = std::panic::catch_unwind(|| cli(argv));
         let _ = tx.send(r);
     });
     rx.recv_timeout(Duration::from_secs(120)).ok()

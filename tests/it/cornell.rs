@@ -1,7 +1,7 @@
+use crate::kit::load;
 use geom::{Prim, Ray};
 use glam::Vec3;
 use math::Rng;
-use tests::load;
 
 fn rand_dir(rng: &mut Rng) -> Vec3 {
     let z = 1.0 - 2.0 * rng.uniform();

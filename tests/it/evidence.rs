@@ -1,24 +1,19 @@
-//! The evidence command's pieces (issue 11) on a small worksheet image: bias and variance
+//! The evidence command's pieces on a small worksheet image: bias and variance
 //! apart from independent runs against a long path-traced reference.
 
+use crate::kit::{TempDir, worksheet, write_worksheet};
 use film::Image;
-use lab::evidence::{Budget, Technique, regions, render_image, rung};
+use lab::evidence::{Budget, Technique, render_image, rung};
+use lab::regions::regions;
 use render::Overrides;
 use scene::{Method, Scene};
 use std::path::{Path, PathBuf};
-use tests::{TempDir, scenes_dir};
 
 const RES: u32 = 48;
 
-fn worksheet(seed: u64) -> Result<Scene, String> {
-    let path = scenes_dir().join("cornell-spheres/analytic.toml");
-    let text = std::fs::read_to_string(&path).map_err(|e| e.to_string())?;
-    Scene::from_toml_with(&path, &text, |f| {
-        f.seed = seed;
-        f.camera.width = RES;
-        f.camera.height = RES;
-    })
-    .map_err(|e| e.to_string())
+/// The worksheet scene at [`RES`] pixels square with seed `seed`, as the studies take it.
+fn at_seed(seed: u64) -> Result<Scene, String> {
+    Ok(worksheet(RES, seed))
 }
 
 fn reference(cache: &Path) -> Image {
@@ -27,7 +22,7 @@ fn reference(cache: &Path) -> Image {
         spp: Some(4096),
         ..Overrides::default()
     };
-    render_image(&worksheet(1000).unwrap(), &o, cache, None)
+    render_image(&worksheet(RES, 1000), &o, cache, None)
         .unwrap_or_else(|e| panic!("{e}"))
         .0
 }
@@ -37,7 +32,7 @@ fn bias_is_zero_for_the_path_tracer_and_grows_with_k_at_the_caustic() {
     let dir = TempDir::new("evidence");
     let cache = dir.path().join("cache");
     let reference = reference(&cache);
-    let scene = worksheet(1).unwrap();
+    let scene = worksheet(RES, 1);
     let regions = regions(&scene);
     let region = |r: &lab::evidence::RungResult, name: &str| {
         r.region(name)
@@ -58,7 +53,7 @@ fn bias_is_zero_for_the_path_tracer_and_grows_with_k_at_the_caustic() {
         layer: None,
     };
     let r = rung(
-        &worksheet, &path, 64, seeds, &reference, &regions, &cache, None,
+        &at_seed, &path, 64, seeds, &reference, &regions, &cache, None,
     )
     .unwrap_or_else(|e| panic!("{e}"));
     let (e, s) = region(&r, "image");
@@ -82,7 +77,7 @@ fn bias_is_zero_for_the_path_tracer_and_grows_with_k_at_the_caustic() {
     };
     let bias = |k| {
         let r = rung(
-            &worksheet,
+            &at_seed,
             &gd(k),
             200_000,
             4,
@@ -189,14 +184,7 @@ fn run_chromium(exe: &Path, profile: &Path, args: &[String]) -> String {
 fn the_report_links_resolve_and_a_browser_shows_its_images() {
     let dir = TempDir::new("evidence-report");
     // The worksheet scene at 64 x 64, its meshes named by absolute paths.
-    let src = scenes_dir().join("cornell-spheres");
-    let text = std::fs::read_to_string(src.join("analytic.toml"))
-        .unwrap()
-        .replace("obj = \"", &format!("obj = \"{}/", src.display()))
-        .replace("width = 512", "width = 64")
-        .replace("height = 512", "height = 64");
-    let scene = dir.path().join("small.toml");
-    std::fs::write(&scene, text).unwrap();
+    let scene = write_worksheet(dir.path(), "small.toml", 64, "");
     let out = dir.path().join("evidence");
     lab::evidence(&lab::evidence::EvidenceArgs {
         scene,

@@ -2,7 +2,7 @@
 //! loader (OBJ, MTL, scene file, photon file, EXR), each one answered without a panic, a hang
 //! or an allocation sized by an unchecked field. `cargo xtask fuzz --seconds N` runs more.
 
-use tests::TempDir;
+use crate::kit::TempDir;
 use tests::fuzz::{Budget, Target, run};
 
 /// Enough that the EXR loop finds a header-sized allocation when the reader's size check is

@@ -1,4 +1,4 @@
-//! Hard cases stay numerically stable (issue 12, point 5): one data-driven table ([`CASES`]),
+//! Hard cases stay numerically stable: one data-driven table ([`CASES`]),
 //! each case a scene built by a function, the methods it runs (through
 //! `render::methods::render`, as the binary does) and a check. Every case checks that every
 //! pixel of every layer of every run is finite and non-negative and that the run made some
@@ -23,14 +23,14 @@
 //! Seeds are fixed; each tolerance is a few standard errors, or near what was measured when
 //! the case is deterministic (the numbers are in the comments and printed by the test).
 
+use crate::kit::{TempDir, bad_pixels, dvec3s, footprint_axes, layer, render, worksheet_with};
 use glam::{DVec3, Vec3};
-use render::{Overrides, Photons, Rendered, Run, Settings};
+use render::{Overrides, Rendered, Settings};
 use scene::{Method, Scene, SceneFile};
 use std::cell::OnceCell;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use store::MapKind;
-use tests::{TempDir, scenes_dir};
 
 // ---------------------------------------------------------------------------------------------
 // The table.
@@ -173,13 +173,13 @@ const CASES: &[Case] = &[
     },
     Case {
         name: "scene scaled by 1e-3",
-        scene: |_| worksheet(WS_RES, 1e-3, |_| {}),
+        scene: |_| scaled_worksheet(WS_RES, 1e-3, |_| {}),
         runs: worksheet_runs,
         check: check_scaled,
     },
     Case {
         name: "scene scaled by 1e4",
-        scene: |_| worksheet(WS_RES, 1e4, |_| {}),
+        scene: |_| scaled_worksheet(WS_RES, 1e4, |_| {}),
         runs: worksheet_runs,
         check: check_scaled,
     },
@@ -198,14 +198,14 @@ const CASES: &[Case] = &[
     },
     Case {
         name: "sphere of radius 1e-4",
-        scene: |_| worksheet(WS_RES, 1.0, add_tiny_spheres),
+        scene: |_| scaled_worksheet(WS_RES, 1.0, add_tiny_spheres),
         runs: worksheet_runs,
         check: check_tiny_sphere,
     },
     Case {
         name: "sphere of radius 1e-4 up close",
         scene: |_| {
-            worksheet(WS_RES, 1.0, |f| {
+            scaled_worksheet(WS_RES, 1.0, |f| {
                 add_tiny_spheres(f);
                 f.camera.eye = [TINY_CENTRE[0], TINY_CENTRE[1], TINY_CENTRE[2] + 4e-4];
                 f.camera.look_at = TINY_CENTRE;
@@ -259,7 +259,7 @@ fn hard_cases_render_finite_images_and_keep_their_flux() {
             let runs: Vec<(Overrides, Rendered)> = (case.runs)()
                 .into_iter()
                 .map(|o| {
-                    let r = render(&scene, &o, &dir.join("cache"));
+                    let r = render(&scene, &o, &dir.join("cache"), None);
                     common_checks(&o, &r);
                     (o, r)
                 })
@@ -347,32 +347,11 @@ fn method(o: &Overrides) -> Method {
     o.method.unwrap_or_else(|| panic!("a run names no method"))
 }
 
-/// Runs `o`'s method; photon methods trace into (or reuse) `cache`.
-fn render(scene: &Scene, o: &Overrides, cache: &Path) -> Rendered {
-    let settings = Settings::new(scene, o).unwrap_or_else(|e| panic!("{e}"));
-    let run = Run {
-        scene,
-        settings: &settings,
-        cache,
-        photons: Photons::TraceOrReuse,
-        threads: None,
-    };
-    render::methods::render(&run, &|_| {}).unwrap_or_else(|e| panic!("{e}"))
-}
-
 /// Every pixel of every layer finite and non-negative, and some light made.
 fn common_checks(o: &Overrides, r: &Rendered) {
     let m = method(o);
     for l in &r.layers {
-        let bad: Vec<(usize, [f32; 3])> = l
-            .image
-            .data
-            .iter()
-            .enumerate()
-            .filter(|(_, p)| p.iter().any(|c| !c.is_finite() || *c < 0.0))
-            .map(|(i, p)| (i, *p))
-            .take(5)
-            .collect();
+        let bad: Vec<(usize, [f32; 3])> = bad_pixels(&l.image).into_iter().take(5).collect();
         assert!(bad.is_empty(), "{m}: layer {}: pixels {bad:?}", l.name);
     }
     let total = mean(&image(r));
@@ -391,19 +370,6 @@ fn image(r: &Rendered) -> Vec<DVec3> {
         }
     }
     img
-}
-
-fn layer(r: &Rendered, name: &str) -> Vec<DVec3> {
-    let l = r.layers.iter().find(|l| l.name == name);
-    let l = l.unwrap_or_else(|| {
-        let names: Vec<&str> = r.layers.iter().map(|l| l.name.as_str()).collect();
-        panic!("no `{name}` layer (layers: {names:?})")
-    });
-    l.image
-        .data
-        .iter()
-        .map(|p| Vec3::from(*p).as_dvec3())
-        .collect()
 }
 
 fn mean(img: &[DVec3]) -> DVec3 {
@@ -523,23 +489,29 @@ impl Obj {
 /// A scene file `name.toml` in `dir` over `name.obj`, with `body` after the mesh (spheres,
 /// materials, `[photons]`, `[estimate]`).
 fn scene_file(dir: &Path, name: &str, camera: &str, body: &str) -> Scene {
+    try_scene_file(dir, name, camera, body).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// [`scene_file`], refusals returned.
+fn try_scene_file(
+    dir: &Path,
+    name: &str,
+    camera: &str,
+    body: &str,
+) -> Result<Scene, scene::SceneError> {
     let text = format!(
         "name = \"{name}\"\nseed = 3\n[camera]\n{camera}\n[[mesh]]\nobj = \"{name}.obj\"\n{body}"
     );
-    Scene::from_toml(&dir.join(format!("{name}.toml")), &text).unwrap_or_else(|e| panic!("{e}"))
+    Scene::from_toml(&dir.join(format!("{name}.toml")), &text)
 }
 
 const LAMP: &str = "type = \"lambertian\"\nalbedo = [0.0, 0.0, 0.0]\n";
 
-/// The worksheet scene (`scenes/cornell-spheres/analytic.toml`) at `res` pixels square with
-/// every length multiplied by `s`: mesh scale, sphere centres and radii, the camera, and
-/// every `[estimate]` length ([`estimate_lengths`]), then `edit`.
-fn worksheet(res: u32, s: f32, edit: fn(&mut SceneFile)) -> Scene {
-    let path = scenes_dir().join("cornell-spheres/analytic.toml");
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{e}"));
-    Scene::from_toml_with(&path, &text, |f| {
-        f.camera.width = res;
-        f.camera.height = res;
+/// The worksheet scene (`scenes/cornell-spheres/analytic.toml`) at `res` pixels square, with
+/// its own seed (1), and every length multiplied by `s`: mesh scale, sphere centres and
+/// radii, the camera, and every `[estimate]` length ([`estimate_lengths`]), then `edit`.
+fn scaled_worksheet(res: u32, s: f32, edit: fn(&mut SceneFile)) -> Scene {
+    worksheet_with(res, 1, |f| {
         f.camera.eye = f.camera.eye.map(|x| x * s);
         f.camera.look_at = f.camera.look_at.map(|x| x * s);
         for m in &mut f.meshes {
@@ -558,7 +530,6 @@ fn worksheet(res: u32, s: f32, edit: fn(&mut SceneFile)) -> Scene {
         f.estimate = estimate_lengths(s);
         edit(f);
     })
-    .unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// `[estimate]` with every length in scene units written out and multiplied by `s` (the
@@ -586,7 +557,7 @@ const GLASS_CENTRE: [f32; 3] = [-3.272, 2.29, -6.2395];
 const GLASS_RADIUS: f32 = 2.25;
 
 fn camera_in_glass(_: &Path) -> Scene {
-    worksheet(24, 1.0, |f| {
+    scaled_worksheet(24, 1.0, |f| {
         f.camera.eye = GLASS_CENTRE;
         // Towards the back wall and the silver sphere.
         f.camera.look_at = [-6.0, 2.29, -12.0];
@@ -633,7 +604,7 @@ fn check_camera_in_glass(ctx: &Ctx) {
 
 /// The worksheet scene seen from under the light, looking up at it and the ceiling round it.
 fn light_under_ceiling(_: &Path) -> Scene {
-    worksheet(24, 1.0, |f| {
+    scaled_worksheet(24, 1.0, |f| {
         f.camera.eye = [-6.95, 4.0, -6.99];
         f.camera.look_at = [-6.95, 13.72, -6.99];
         f.camera.up = [0.0, 0.0, -1.0];
@@ -676,7 +647,7 @@ fn check_light_under_ceiling(ctx: &Ctx) {
     );
     // The light seen directly is its radiance, exactly (f64 sums of equal f32 values).
     for m in [Method::Path, Method::GlobalDirect, Method::FinalGather] {
-        let e = layer(run_of(ctx, m), "emitted");
+        let e = dvec3s(layer(run_of(ctx, m), "emitted"));
         for &i in &lamp {
             assert_eq!(e[i], le, "{m}: pixel {i}");
         }
@@ -684,7 +655,7 @@ fn check_light_under_ceiling(ctx: &Ctx) {
     // The ceiling lies behind the light's emitting side: no direct light reaches it, so the
     // path tracer's direct layer is zero there, to the bit (a light leaking through the
     // 0.0025 gap or a shadow ray slipping past it would show here).
-    let direct = layer(run_of(ctx, Method::Path), "direct");
+    let direct = dvec3s(layer(run_of(ctx, Method::Path), "direct"));
     let leak: Vec<(usize, DVec3)> = ceiling
         .iter()
         .filter(|&&i| direct[i] != DVec3::ZERO)
@@ -791,7 +762,7 @@ fn check_grazing(ctx: &Ctx) {
         .iter()
         .map(|&(i, _)| angle(i))
         .fold((f32::INFINITY, 0.0f32), |(a, b), x| (a.min(x), b.max(x)));
-    let path = layer(run_of(ctx, Method::Path), "direct");
+    let path = dvec3s(layer(run_of(ctx, Method::Path), "direct"));
     let got: Vec<DVec3> = pixels.iter().map(|&(i, _)| path[i]).collect();
     let want: Vec<DVec3> = pixels.iter().map(|&(_, e)| e).collect();
     let z = pixel_z(&got, &want);
@@ -1022,15 +993,7 @@ fn check_focus(ctx: &Ctx) {
         ..emit::EmitParams::default()
     };
     let ps = emit::trace_caustics(scene, &params, 1.0, 0, 0..FOCUS_PHOTONS, false);
-    let minor = |p: &emit::CausticPhoton| {
-        let (a, b) = (
-            p.a - p.a.dot(p.normal) * p.normal,
-            p.b - p.b.dot(p.normal) * p.normal,
-        );
-        let (p2, q, r2) = (a.length_squared(), a.dot(b), b.length_squared());
-        let dev = (0.25 * (p2 - r2) * (p2 - r2) + q * q).sqrt();
-        (0.5 * (p2 + r2) - dev).max(0.0).sqrt()
-    };
+    let minor = |p: &emit::CausticPhoton| footprint_axes(p).1;
     let focused = ps.iter().filter(|p| minor(p) < 1e-3).count();
     let smallest = ps.iter().map(minor).fold(f32::INFINITY, f32::min);
     // The caustic flux landing in the clean pixels, by projecting each photon.
@@ -1044,7 +1007,7 @@ fn check_focus(ctx: &Ctx) {
     let photon_flux: f64 = ps.iter().filter(|p| seen(p)).map(|p| p.flux.x as f64).sum();
     let all_flux: f64 = ps.iter().map(|p| p.flux.x as f64).sum();
     // What the splatted caustic layer integrates to over the same pixels: L = rho/pi E.
-    let caustic = layer(run_of(ctx, Method::CausticSplat), "caustic");
+    let caustic = dvec3s(layer(run_of(ctx, Method::CausticSplat), "caustic"));
     let image_flux: f64 = pixels.iter().map(|&(i, a)| caustic[i].x * a).sum::<f64>()
         * std::f64::consts::PI
         / FOCUS_RHO;
@@ -1062,7 +1025,7 @@ fn check_focus(ctx: &Ctx) {
     assert!(photon_flux > 0.5 * all_flux, "{photon_flux} of {all_flux}");
     // Measured: +2.5% (the eye vertices' sampling of the focus, 16 per pixel, and splats
     // crossing the ball's silhouette). Before each spacing level of eye vertices read the
-    // photons through its own footprint (`render::splat::EyeIndex`), -24%: a focused
+    // photons through its own footprint (`density::splat::Receivers`), -24%: a focused
     // photon's footprint was clamped to the spacing of its nearest vertex, often one seen
     // through the ball, and fell between the directly seen floor's vertices (16 passes:
     // -20%, so a bias, not noise).
@@ -1187,7 +1150,7 @@ fn check_point_photons(ctx: &Ctx) {
     for (run, k) in [(0, 50.0), (1, POINT_PHOTONS as f64)] {
         let (o, r) = &ctx.runs[run];
         assert_eq!(o.k, Some(k as usize));
-        let img = layer(r, "global");
+        let img = dvec3s(layer(r, "global"));
         let l = |d: f64| {
             POINT_RHO / std::f64::consts::PI * k * POINT_FLUX as f64
                 / (std::f64::consts::PI * d * d)
@@ -1258,7 +1221,7 @@ fn check_k_above_count(ctx: &Ctx) {
     // k = 2 000 > 1 000 photons with r_max = 0.5: the radius is r_max wherever the disc
     // holds the point, so E = Phi / (pi r_max^2) inside the disc and zero outside: a fixed
     // kernel, whose integral over the floor is the photons' flux (1 W per channel).
-    let img = layer(&ctx.runs[0].1, "global");
+    let img = dvec3s(layer(&ctx.runs[0].1, "global"));
     let r = POINT_R_MAX as f64;
     let l_in = POINT_RHO / std::f64::consts::PI * 1.0 / (std::f64::consts::PI * r * r);
     let (mut inside, mut flux) = (0, 0.0);
@@ -1310,12 +1273,12 @@ struct Shared {
 
 fn reference<'a>(ctx: &Ctx<'a>) -> &'a [(Overrides, Rendered)] {
     ctx.shared.reference.get_or_init(|| {
-        let scene = worksheet(WS_RES, 1.0, |_| {});
+        let scene = scaled_worksheet(WS_RES, 1.0, |_| {});
         let cache = ctx.shared.root.join("reference-cache");
         worksheet_runs()
             .into_iter()
             .map(|o| {
-                let r = render(&scene, &o, &cache);
+                let r = render(&scene, &o, &cache, None);
                 (o, r)
             })
             .collect()
@@ -1508,7 +1471,7 @@ fn check_degenerate(ctx: &Ctx) {
     let clean = floor_scene(ctx.dir, false);
     let cache = ctx.dir.join("clean-cache");
     for (o, r) in ctx.runs {
-        let c = render(&clean, o, &cache);
+        let c = render(&clean, o, &cache, None);
         let (a, b) = (image(r), image(&c));
         let same = a.iter().zip(&b).filter(|(x, y)| x == y).count();
         eprintln!(
@@ -1545,10 +1508,7 @@ fn power_scene(dir: &Path, le: f32) -> Result<Scene, scene::SceneError> {
          [material.glass]\ntype = \"dielectric\"\nior = 1.5\n\
          [material.lamp]\n{LAMP}emission = [{le:e}, {le:e}, {le:e}]\n"
     );
-    let text = format!(
-        "name = \"{name}\"\nseed = 3\n[camera]\n{camera}\n[[mesh]]\nobj = \"{name}.obj\"\n{body}"
-    );
-    Scene::from_toml(&dir.join(format!("{name}.toml")), &text)
+    try_scene_file(dir, &name, camera, &body)
 }
 
 fn check_huge_power(ctx: &Ctx) {
@@ -1560,7 +1520,7 @@ fn check_huge_power(ctx: &Ctx) {
     let unit = power_scene(ctx.dir, 1.0).unwrap_or_else(|e| panic!("{e}"));
     let cache = ctx.dir.join("unit-cache");
     for (o, r) in ctx.runs {
-        let u = render(&unit, o, &cache);
+        let u = render(&unit, o, &cache, None);
         let mut worst = 0.0f64;
         for (lh, lu) in r.layers.iter().zip(&u.layers) {
             for (a, b) in lh.image.data.iter().zip(&lu.image.data) {

@@ -29,6 +29,9 @@
 //!   shards merged give the one-machine run's photon files and images byte for byte.
 //! - `sppm`: progressive photon mapping converging to closed forms (square light, furnace) at
 //!   the rate its radius schedule predicts; snapshots, time budget, thread-count invariance.
+//! - `kit`: the helpers the modules share (scenes at a test's resolution and seed, methods run
+//!   as the binary runs them, layers, pixels and regions of images, means with standard
+//!   errors, scratch directories, the command line in process).
 
 // Per-thread largest allocation, for the fuzz loops' check.
 #[global_allocator]
@@ -39,6 +42,7 @@ mod cornell;
 mod evidence;
 mod fuzz;
 mod hard_cases;
+mod kit;
 mod photon_maps;
 mod photons;
 mod shards;

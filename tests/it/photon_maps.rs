@@ -9,70 +9,18 @@
 //! - global-direct and final gathering on the worksheet scene against the path tracer,
 //!   region by region.
 
+use crate::kit::{
+    Mean, TempDir, load, pixel, pixels_seeing, rect, region_mean, render_cached, scene_in,
+    sum_layers, worksheet,
+};
 use density::{EstimateParams, IndexKind, Kernel, KnnHint, PhotonMap};
 use geom::Prim;
 use glam::{DVec3, Vec3};
 use render::maps::Maps;
-use render::{Overrides, Photons, Rendered, Run, Settings};
+use render::{Overrides, Rendered};
 use scene::{Material, Method, Scene};
 use std::path::Path;
 use store::{MapKind, PerKind};
-use tests::{TempDir, load, scenes_dir};
-
-/// Runs a method with `o` on photon sets already in `cache` (never traces), as the
-/// `estimate` command does.
-fn render(scene: &Scene, o: &Overrides, cache: &Path) -> Rendered {
-    let settings = Settings::new(scene, o).unwrap_or_else(|e| panic!("{e}"));
-    let run = Run {
-        scene,
-        settings: &settings,
-        cache,
-        photons: Photons::CacheOnly,
-        threads: None,
-    };
-    render::methods::render(&run, &|_| {}).unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// The image: the sum of the layers whose names pass `keep`.
-fn sum_layers(scene: &Scene, r: &Rendered, keep: impl Fn(&str) -> bool) -> film::Image {
-    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-    let mut img = film::Image::new(w, h);
-    for l in r.layers.iter().filter(|l| keep(&l.name)) {
-        img.add(&l.image).unwrap_or_else(|e| panic!("{e}"));
-    }
-    img
-}
-
-fn pixel(img: &film::Image, x: usize, y: usize) -> DVec3 {
-    let [r, g, b] = img.get(x, y);
-    DVec3::new(r as f64, g as f64, b as f64)
-}
-
-/// Mean and standard error of independent samples, per channel, in f64.
-#[derive(Clone, Copy, Default)]
-struct Mean {
-    n: f64,
-    sum: DVec3,
-    sum2: DVec3,
-}
-
-impl Mean {
-    fn add(&mut self, x: DVec3) {
-        self.n += 1.0;
-        self.sum += x;
-        self.sum2 += x * x;
-    }
-
-    fn mean(&self) -> DVec3 {
-        self.sum / self.n
-    }
-
-    fn se(&self) -> DVec3 {
-        let m = self.mean();
-        let var = (self.sum2 / self.n - m * m) * (self.n / (self.n - 1.0));
-        (var.max(DVec3::ZERO) / self.n).powf(0.5)
-    }
-}
 
 // ---------------------------------------------------------------------------------------------
 // 1. The furnace.
@@ -157,13 +105,27 @@ fn furnace_interior(scene: &Scene, margin: f32) -> (Vec<(usize, usize)>, f32) {
     (inner, spacing)
 }
 
-/// Mean of the image over `pixels`, with its standard error from their spread.
-fn mean_over(img: &film::Image, pixels: &[(usize, usize)]) -> (DVec3, DVec3) {
-    let mut m = Mean::default();
-    for &(x, y) in pixels {
-        m.add(pixel(img, x, y));
-    }
+/// The furnace rendered with `o` from the `stored` photons traced into `cache`: the image's
+/// mean over `pixels`, with its standard error from their spread.
+fn furnace_mean(
+    scene: &Scene,
+    o: &Overrides,
+    cache: &Path,
+    stored: u64,
+    pixels: &[(usize, usize)],
+) -> (DVec3, DVec3) {
+    let rendered = render_cached(scene, o, cache);
+    assert_eq!(rendered.info["global_photons"].as_u64(), Some(stored));
+    let img = sum_layers(&rendered, |_| true);
+    let m = Mean::of(pixels.iter().map(|&p| pixel(&img, p)));
     (m.mean(), m.se())
+}
+
+/// The check resolves the bias: the box kernel's image, `m ± se`, is far from the unbiased
+/// value.
+fn assert_bias_resolved((m, se): (DVec3, DVec3), unbiased: DVec3) {
+    let z = ((m - unbiased) / se).min_element();
+    assert!(z > 6.0, "uniform kernel {m} ± {se} vs unbiased {unbiased}");
 }
 
 /// `got ± se` is within `z` standard errors of `predicted`, per channel.
@@ -234,10 +196,7 @@ fn furnace_global_direct_shows_le_over_one_minus_rho_with_the_predicted_knn_bias
             photons: Some(FURNACE_PATHS),
             ..Overrides::default()
         };
-        let rendered = render(&scene, &o, dir.path());
-        assert_eq!(rendered.info["global_photons"].as_u64(), Some(stored));
-        let img = sum_layers(&scene, &rendered, |_| true);
-        let (m, se) = mean_over(&img, &kept);
+        let (m, se) = furnace_mean(&scene, &o, dir.path(), stored, &kept);
         eprintln!(
             "furnace, global-direct, k = {k}, {name}: {m:.4} ± {se:.4}, predicted {predicted:.4}"
         );
@@ -246,10 +205,7 @@ fn furnace_global_direct_shows_le_over_one_minus_rho_with_the_predicted_knn_bias
             uniform = (m, se);
         }
     }
-    // The check resolves the bias: the box kernel's image is far from the unbiased value.
-    let (m, se) = uniform;
-    let z = ((m - unbiased) / se).min_element();
-    assert!(z > 6.0, "uniform kernel {m} ± {se} vs unbiased {unbiased}");
+    assert_bias_resolved(uniform, unbiased);
 }
 
 #[test]
@@ -295,10 +251,7 @@ fn furnace_final_gathering_shows_le_over_one_minus_rho_with_the_predicted_knn_bi
             photons: Some(FURNACE_PATHS),
             ..Overrides::default()
         };
-        let rendered = render(&scene, &o, dir.path());
-        assert_eq!(rendered.info["global_photons"].as_u64(), Some(stored));
-        let img = sum_layers(&scene, &rendered, |_| true);
-        let (m, se) = mean_over(&img, &interior);
+        let (m, se) = furnace_mean(&scene, &o, dir.path(), stored, &interior);
         let predicted = le + rho * le + gathered * bias;
         eprintln!(
             "furnace, final gathering, k = {k}, {name}: {m:.4} ± {se:.4}, predicted {predicted:.4}"
@@ -308,21 +261,11 @@ fn furnace_final_gathering_shows_le_over_one_minus_rho_with_the_predicted_knn_bi
             uniform = (m, se);
         }
     }
-    let (m, se) = uniform;
-    let z = ((m - unbiased) / se).min_element();
-    assert!(z > 6.0, "uniform kernel {m} ± {se} vs unbiased {unbiased}");
+    assert_bias_resolved(uniform, unbiased);
 }
 
 // ---------------------------------------------------------------------------------------------
 // 2. Boundary correction through `Maps::estimate`, the estimate the eye pass calls.
-
-/// Writes `files` into `dir` and loads the scene file `toml` from there.
-fn scene_in(dir: &Path, files: &[(&str, &str)], toml: &str) -> Scene {
-    for (name, text) in files {
-        std::fs::write(dir.join(name), text).unwrap_or_else(|e| panic!("{name}: {e}"));
-    }
-    Scene::from_toml(&dir.join("scene.toml"), toml).unwrap_or_else(|e| panic!("{e}"))
-}
 
 /// The global map alone, estimated with `params`, boundary correction off.
 fn global_maps(photons: Vec<store::Photon>, params: EstimateParams) -> Maps<'static> {
@@ -365,7 +308,7 @@ fn stats(values: impl IntoIterator<Item = f64>) -> (f64, f64, f64) {
     for v in values {
         m.add(DVec3::splat(v));
     }
-    let sd = m.se().x * m.n.sqrt();
+    let sd = m.se().x * m.n().sqrt();
     (m.mean().x, m.se().x, sd)
 }
 
@@ -402,6 +345,7 @@ fn boundary_correction_restores_the_edges_and_corners_of_a_uniformly_lit_square(
                 "newmtl white\nKd 0.5 0.5 0.5\nnewmtl light\nKe 1 1 1\n",
             ),
         ],
+        "scene.toml",
         "[camera]\neye = [2, 5, 2.01]\nlook_at = [2, 0, 2]\nvfov = 60\nwidth = 8\nheight = 8\n\
          [[mesh]]\nobj = \"f.obj\"\n",
     );
@@ -508,6 +452,7 @@ fn boundary_correction_leaves_a_diffuse_sphere_alone() {
             ),
             ("light.mtl", "newmtl light\nKe 1 1 1\n"),
         ],
+        "scene.toml",
         "[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nvfov = 40\nwidth = 8\nheight = 8\n\
          [[mesh]]\nobj = \"light.obj\"\n\
          [[sphere]]\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"white\"\n\
@@ -590,118 +535,38 @@ fn boundary_correction_leaves_a_diffuse_sphere_alone() {
 /// below are in these pixels.
 const RES: u32 = 64;
 
-/// The worksheet scene with the camera's resolution reduced to [`RES`] and seed `seed`.
-fn worksheet(seed: u64) -> Scene {
-    let path = scenes_dir().join("cornell-spheres/analytic.toml");
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{e}"));
-    let edited = text
-        .replace("width = 512", &format!("width = {RES}"))
-        .replace("height = 512", &format!("height = {RES}"))
-        .replace("seed = 1\n", &format!("seed = {seed}\n"));
-    assert_ne!(text, edited);
-    let scene = Scene::from_toml(&path, &edited).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(
-        (scene.camera.width, scene.camera.height, scene.seed()),
-        (RES, RES, seed)
-    );
-    scene
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Wall {
-    Back,
-    Left,
-    Right,
-    Floor,
-    Ceiling,
-}
-
-/// The wall a camera ray through `(x, y)` (pixel units) sees first, if any: a non-emitting
-/// triangle of the box, told by its material and which way it faces.
-fn wall_seen(scene: &Scene, x: f32, y: f32) -> Option<Wall> {
-    let ray = scene.camera.ray(x, y);
-    let hit = scene.geometry.intersect(&ray)?;
-    if matches!(hit.prim, Prim::Sphere(_)) || scene.emission[hit.material as usize] != Vec3::ZERO {
-        return None;
-    }
-    let n = hit.point.n * -hit.point.n.dot(ray.d).signum();
-    let name = scene.material_names[hit.material as usize].as_str();
-    match name {
-        "red" if n.x > 0.9 => Some(Wall::Left),
-        "green" if n.x < -0.9 => Some(Wall::Right),
-        "white" if n.z > 0.9 => Some(Wall::Back),
-        "white" if n.y > 0.9 => Some(Wall::Floor),
-        "white" if n.y < -0.9 => Some(Wall::Ceiling),
-        _ => None,
-    }
-}
-
-/// The pixels of `rect` (`[x0, y0, x1, y1)`) that see `wall` only: their centre and four
-/// points near their corners all hit it. Most of the rectangle must.
-fn region(scene: &Scene, wall: Wall, rect: [usize; 4]) -> Vec<(usize, usize)> {
-    let [x0, y0, x1, y1] = rect;
-    let mut px = Vec::new();
-    for y in y0..y1 {
-        for x in x0..x1 {
-            let all = [
-                (0.5, 0.5),
-                (0.02, 0.02),
-                (0.98, 0.02),
-                (0.02, 0.98),
-                (0.98, 0.98),
-            ]
-            .iter()
-            .all(|(u, v)| wall_seen(scene, x as f32 + u, y as f32 + v) == Some(wall));
-            if all {
-                px.push((x, y));
-            }
-        }
-    }
+/// The pixels of `r` (`[x0, y0, x1, y1)`) that see the wall `name` ([`crate::kit::seen`]) only: their
+/// centre and four points near their corners all hit it. Most of the rectangle must.
+fn region(scene: &Scene, name: &str, r: [usize; 4]) -> Vec<(usize, usize)> {
+    let px = pixels_seeing(scene, r, |s| s == name);
+    let [x0, y0, x1, y1] = r;
     assert!(
         px.len() * 3 >= (x1 - x0) * (y1 - y0) * 2,
-        "{wall:?}: only {} pixels of {rect:?} see it",
+        "{name}: only {} pixels of {r:?} see it",
         px.len()
     );
     px
 }
 
-fn region_mean(img: &film::Image, pixels: &[(usize, usize)]) -> DVec3 {
-    pixels.iter().map(|&(x, y)| pixel(img, x, y)).sum::<DVec3>() / pixels.len() as f64
-}
-
 /// The regions compared, as pixel sets of the [`RES`]-square image.
 fn worksheet_regions(scene: &Scene) -> Vec<(&'static str, Vec<(usize, usize)>)> {
-    let all: Vec<(usize, usize)> = (0..RES as usize)
-        .flat_map(|y| (0..RES as usize).map(move |x| (x, y)))
-        .collect();
+    let whole = [0, 0, RES as usize, RES as usize];
     // Every pixel that sees the box's walls only (no sphere, light or open front).
-    let walls: Vec<(usize, usize)> = all
-        .iter()
-        .copied()
-        .filter(|&(x, y)| {
-            [
-                (0.5, 0.5),
-                (0.02, 0.02),
-                (0.98, 0.02),
-                (0.02, 0.98),
-                (0.98, 0.98),
-            ]
-            .iter()
-            .all(|(u, v)| wall_seen(scene, x as f32 + u, y as f32 + v).is_some())
-        })
-        .collect();
+    let walls = pixels_seeing(scene, whole, |s| {
+        s.ends_with("wall") || s == "floor" || s == "ceiling"
+    });
     vec![
-        ("back wall", region(scene, Wall::Back, [20, 18, 44, 33])),
-        ("left wall", region(scene, Wall::Left, [2, 18, 12, 33])),
-        ("right wall", region(scene, Wall::Right, [52, 18, 62, 33])),
-        ("floor", region(scene, Wall::Floor, [16, 55, 48, 63])),
-        ("ceiling", region(scene, Wall::Ceiling, [18, 1, 46, 8])),
+        ("back wall", region(scene, "back wall", [20, 18, 44, 33])),
+        ("left wall", region(scene, "left wall", [2, 18, 12, 33])),
+        ("right wall", region(scene, "right wall", [52, 18, 62, 33])),
+        ("floor", region(scene, "floor", [16, 55, 48, 63])),
+        ("ceiling", region(scene, "ceiling", [18, 1, 46, 8])),
         ("walls", walls),
         // Not compared: the floor just in front of the glass sphere, where part of its
         // caustic shows. Both methods read it 29% ± 13% brighter than the path tracer there
         // (12 seeds), the k-NN discs spreading the caustic's focus, hidden under the sphere,
         // onto the visible floor; the walls resolve the caustic layer instead.
-        ("image", all),
+        ("image", rect(whole)),
     ]
 }
 
@@ -720,7 +585,7 @@ struct Comparison {
 const PATH_SPP: u32 = 1024;
 
 fn compare_worksheet(seed: u64) -> Vec<Comparison> {
-    let scene = worksheet(seed);
+    let scene = worksheet(RES, seed);
     let dir = TempDir::new(&format!("photon-maps-worksheet-{seed}"));
     // The scene's own [photons] and [estimate] tables: 200 000 paths; k = 1000 (global) and
     // 250 (caustic), uniform kernel; final gathering through the irradiance cache (every 4th
@@ -733,18 +598,18 @@ fn compare_worksheet(seed: u64) -> Vec<Comparison> {
         spp: Some(spp),
         ..Overrides::default()
     };
-    let path = render(&scene, &with(Method::Path, PATH_SPP), dir.path());
-    let gd = render(&scene, &with(Method::GlobalDirect, 4), dir.path());
-    let fg = render(&scene, &with(Method::FinalGather, 4), dir.path());
+    let path = render_cached(&scene, &with(Method::Path, PATH_SPP), dir.path());
+    let gd = render_cached(&scene, &with(Method::GlobalDirect, 4), dir.path());
+    let fg = render_cached(&scene, &with(Method::FinalGather, 4), dir.path());
     let names = |r: &Rendered| r.layers.iter().map(|l| l.name.clone()).collect::<Vec<_>>();
     assert_eq!(names(&gd), ["emitted", "global"]);
     assert_eq!(names(&fg), ["emitted", "direct", "caustic", "indirect"]);
-    let path = sum_layers(&scene, &path, |_| true);
-    let gd = sum_layers(&scene, &gd, |_| true);
+    let path = sum_layers(&path, |_| true);
+    let gd = sum_layers(&gd, |_| true);
     let fg_layers = fg;
-    let fg = sum_layers(&scene, &fg_layers, |_| true);
-    let fg_no_caustic = sum_layers(&scene, &fg_layers, |l| l != "caustic");
-    let fg_no_indirect = sum_layers(&scene, &fg_layers, |l| l != "indirect");
+    let fg = sum_layers(&fg_layers, |_| true);
+    let fg_no_caustic = sum_layers(&fg_layers, |l| l != "caustic");
+    let fg_no_indirect = sum_layers(&fg_layers, |l| l != "indirect");
     worksheet_regions(&scene)
         .into_iter()
         .map(|(name, px)| {

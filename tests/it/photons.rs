@@ -1,7 +1,8 @@
 //! Photon flux, end to end: the caustic photons under the glass sphere against the path
-//! tracer's caustic light over the same floor region (issue 4), and the stored first hits of a
+//! tracer's caustic light over the same floor region, and the stored first hits of a
 //! closed box against its light power.
 
+use crate::kit::{Mean, load, scenes_dir};
 use bsdf::TransportMode;
 use emit::{EmitParams, Plan, chunks, trace_parallel, trace_range};
 use eye::{Class, PathOptions, PathTracer};
@@ -13,7 +14,6 @@ use scene::SPHERE_BIT;
 use scene::{Material, Scene};
 use std::f64::consts::PI;
 use store::MapKind;
-use tests::{load, scenes_dir};
 
 /// The region R: floor points within this distance of the point under the glass sphere's
 /// centre (-3.272, 2.29, -6.2395), r = 2.25.
@@ -43,30 +43,6 @@ fn white(scene: &Scene) -> u32 {
         .expect("the box has a white floor")
 }
 
-/// Mean and standard error of independent samples, per channel, in f64.
-#[derive(Default)]
-struct Mean {
-    n: f64,
-    sum: DVec3,
-    sum2: DVec3,
-}
-
-impl Mean {
-    fn add(&mut self, x: DVec3) {
-        self.n += 1.0;
-        self.sum += x;
-        self.sum2 += x * x;
-    }
-    fn mean(&self) -> DVec3 {
-        self.sum / self.n
-    }
-    fn se(&self) -> DVec3 {
-        let m = self.mean();
-        let var = (self.sum2 / self.n - m * m) * (self.n / (self.n - 1.0));
-        (var.max(DVec3::ZERO) / self.n).powf(0.5)
-    }
-}
-
 /// Photon side: `Φ_R`, the summed power of the caustic photons (first diffuse hit of an
 /// `L S+ D` path) stored in R, over `paths` emitted paths. Its standard error comes from the
 /// spread of `batches` disjoint index ranges, which are independent photon streams.
@@ -94,9 +70,9 @@ fn photon_flux(scene: &Scene, paths: u64, batches: u64) -> (DVec3, DVec3, usize)
         }
         per_batch.add(sum);
     }
-    assert_eq!(per_batch.n as u64, batches);
-    let k = per_batch.n;
-    (per_batch.sum, per_batch.se() * k, count)
+    assert_eq!(per_batch.n() as u64, batches);
+    let k = per_batch.n();
+    (per_batch.sum(), per_batch.se() * k, count)
 }
 
 /// A uniform point of R, found as a ray straight down from just above the floor (under the

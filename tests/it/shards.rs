@@ -1,34 +1,18 @@
-//! Shards merged (issue 14): `trace --shard`, `render --shard` (the path tracer, and
+//! Shards merged: `trace --shard`, `render --shard` (the path tracer, and
 //! splatting's passes as the progressive method) and `merge`, through the command line in
 //! process, against the one-machine run byte for byte, with 1, 3 and 7 shards given in
 //! scrambled order. The refusals of bad shard sets are cases of `bad_input`'s table.
 
+use crate::kit::{TempDir, cli, write_worksheet};
 use std::path::{Path, PathBuf};
-use tests::{TempDir, scenes_dir};
 
 /// The worksheet scene at 20 x 20 pixels, written into `dir` (its mesh named by absolute path).
 fn scene(dir: &Path) -> PathBuf {
-    let src = scenes_dir().join("cornell-spheres");
-    let text = std::fs::read_to_string(src.join("analytic.toml"))
-        .unwrap()
-        .replace("width = 512", "width = 20")
-        .replace("height = 512", "height = 20")
-        .replace(
-            "obj = \"CornellBox.obj\"",
-            &format!(
-                "obj = {:?}",
-                src.join("CornellBox.obj").display().to_string()
-            ),
-        )
-        + "\n[estimate.splat]\nphotons = 3000\n";
-    let p = dir.join("s.toml");
-    std::fs::write(&p, text).unwrap();
-    p
+    write_worksheet(dir, "s.toml", 20, "\n[estimate.splat]\nphotons = 3000\n")
 }
 
 fn run(args: &str) {
-    let argv = std::iter::once("photonflow").chain(args.split(' '));
-    let (code, msg) = photonflow::run_args(argv);
+    let (code, msg) = cli(args.split(' ').map(String::from));
     assert_eq!(code, 0, "`{args}`: {msg:?}");
 }
 

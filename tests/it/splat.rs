@@ -1,6 +1,6 @@
-//! Photon differential splatting end to end (issue 9), through the functions the binary calls
+//! Photon differential splatting end to end, through the functions the binary calls
 //! (`render::methods::render`) and the splatting stage's own pieces (`eye::eye_vertices`,
-//! `render::splat::{EyeIndex, Splatter}`):
+//! `render::splat::{receivers, Splatter}`, `density::splat::splat`):
 //!
 //! 1. the splatted caustic under the glass sphere against the path tracer's caustic layer;
 //! 2. `path+splat` against `path`, region by region, and its layers' classes;
@@ -10,116 +10,31 @@
 //!    pixel finite and non-negative, and the splats deposit exactly the photons' flux;
 //! 5. the same image bit for bit on 1 and 2 threads.
 
+use crate::kit::{
+    Mean, TempDir, bad_pixels, bits, footprint_axes, layer, pixels_seeing, rect, region_mean,
+    render, render_uncached, scene_in, sum_layers, worksheet_with,
+};
 use emit::{CausticPhoton, EmitParams, Plan};
 use eye::{EyeVertex, VertexOptions};
 use film::Class;
 use flow::PipelineOptions;
-use geom::Prim;
 use glam::{DVec3, Vec3};
-use render::methods::CountKind;
+use render::rendered::CountKind;
 use render::settings::SplatSettings;
-use render::splat::{EyeIndex, Splatter};
-use render::{Overrides, Photons, Rendered, Run, Settings};
+use render::splat::{Splatter, receivers};
+use render::{Overrides, Rendered};
 use scene::{Method, Scene};
 use std::path::Path;
 use std::sync::OnceLock;
 use store::MapKind;
-use tests::{TempDir, scenes_dir};
 
-/// The worksheet scene (`scenes/cornell-spheres/analytic.toml`) at `res` x `res` pixels,
-/// with seed `seed` and `[estimate] spp = estimate_spp` (the splat's eye vertices per pixel).
+/// The worksheet scene at `res` x `res` pixels, with seed `seed` and `[estimate] spp =
+/// estimate_spp` (the splat's eye vertices per pixel).
 fn worksheet(res: u32, seed: u64, estimate_spp: u32) -> Scene {
-    let path = scenes_dir().join("cornell-spheres/analytic.toml");
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{e}"));
-    let scene = Scene::from_toml_with(&path, &text, |f| {
-        f.seed = seed;
-        f.camera.width = res;
-        f.camera.height = res;
+    worksheet_with(res, seed, |f| {
         f.estimate
             .insert("spp".into(), toml::Value::Integer(estimate_spp as i64));
     })
-    .unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(
-        (scene.camera.width, scene.camera.height, scene.seed()),
-        (res, res, seed)
-    );
-    scene
-}
-
-/// Runs the method `o` names on `threads` threads; photon methods may trace into `cache`.
-fn render_in(scene: &Scene, o: &Overrides, threads: Option<usize>, cache: &Path) -> Rendered {
-    let settings = Settings::new(scene, o).unwrap_or_else(|e| panic!("{e}"));
-    let run = Run {
-        scene,
-        settings: &settings,
-        cache,
-        photons: Photons::TraceOrReuse,
-        threads,
-    };
-    render::methods::render(&run, &|_| {}).unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// [`render_in`] for the methods that read no photon map (the cache is never touched).
-fn render(scene: &Scene, o: &Overrides, threads: Option<usize>) -> Rendered {
-    render_in(
-        scene,
-        o,
-        threads,
-        Path::new("/nonexistent/photonflow-it-splat-cache"),
-    )
-}
-
-/// The image: the sum of the layers whose names pass `keep`.
-fn sum_layers(r: &Rendered, keep: impl Fn(&str) -> bool) -> film::Image {
-    let first = &r.layers[0].image;
-    let mut img = film::Image::new(first.width, first.height);
-    for l in r.layers.iter().filter(|l| keep(&l.name)) {
-        img.add(&l.image).unwrap_or_else(|e| panic!("{e}"));
-    }
-    img
-}
-
-fn layer<'a>(r: &'a Rendered, name: &str) -> &'a film::Image {
-    let l = r.layers.iter().find(|l| l.name == name);
-    &l.unwrap_or_else(|| panic!("no `{name}` layer")).image
-}
-
-fn pixel(img: &film::Image, (x, y): (usize, usize)) -> DVec3 {
-    Vec3::from(img.get(x, y)).as_dvec3()
-}
-
-fn region_mean(img: &film::Image, pixels: &[(usize, usize)]) -> DVec3 {
-    pixels.iter().map(|&p| pixel(img, p)).sum::<DVec3>() / pixels.len() as f64
-}
-
-/// Mean and standard error of independent samples, per channel, in f64.
-#[derive(Clone, Copy, Default)]
-struct Mean {
-    n: f64,
-    sum: DVec3,
-    sum2: DVec3,
-}
-
-impl Mean {
-    fn of(xs: impl IntoIterator<Item = DVec3>) -> Mean {
-        let mut m = Mean::default();
-        for x in xs {
-            m.n += 1.0;
-            m.sum += x;
-            m.sum2 += x * x;
-        }
-        m
-    }
-
-    fn mean(&self) -> DVec3 {
-        self.sum / self.n
-    }
-
-    fn se(&self) -> DVec3 {
-        let m = self.mean();
-        let var = (self.sum2 / self.n - m * m) * (self.n / (self.n - 1.0));
-        (var.max(DVec3::ZERO) / self.n).powf(0.5)
-    }
 }
 
 /// The combined standard error of `a - b`, per channel.
@@ -163,6 +78,9 @@ const SPLAT_PHOTONS: u64 = 250_000;
 /// the focus through the glass. It holds the caustic with a pixel of margin on every side.
 const CAUSTIC_RECT: [usize; 4] = [41, 52, 50, 56];
 
+/// The whole [`RES`] image, as a rectangle.
+const WHOLE: [usize; 4] = [0, 0, RES as usize, RES as usize];
+
 struct WorksheetRuns {
     /// `path` with seeds `1..=RUNS`.
     path: Vec<Rendered>,
@@ -181,7 +99,7 @@ fn worksheet_runs() -> &'static WorksheetRuns {
                     spp: Some(PATH_SPP),
                     ..Overrides::default()
                 };
-                render(&worksheet(RES, seed, 1), &o, None)
+                render_uncached(&worksheet(RES, seed, 1), &o, None)
             })
             .collect();
         let path_splat = (101..=100 + RUNS)
@@ -192,17 +110,11 @@ fn worksheet_runs() -> &'static WorksheetRuns {
                     splat_photons: Some(SPLAT_PHOTONS),
                     ..Overrides::default()
                 };
-                render(&worksheet(RES, seed, SPLAT_SPP), &o, None)
+                render_uncached(&worksheet(RES, seed, SPLAT_SPP), &o, None)
             })
             .collect();
         WorksheetRuns { path, path_splat }
     })
-}
-
-fn rect(r: [usize; 4]) -> Vec<(usize, usize)> {
-    (r[1]..r[3])
-        .flat_map(|y| (r[0]..r[2]).map(move |x| (x, y)))
-        .collect()
 }
 
 /// Per channel, over the runs: the mean of `f(run)`.
@@ -214,7 +126,7 @@ fn over_runs(runs: &[Rendered], f: impl Fn(&Rendered) -> DVec3) -> Mean {
 fn splatted_caustic_under_the_glass_sphere_matches_the_path_tracer() {
     let runs = worksheet_runs();
     let region = rect(CAUSTIC_RECT);
-    let all = rect([0, 0, RES as usize, RES as usize]);
+    let all = rect(WHOLE);
     // The region's caustic light, each run's mean over the region's pixels; the standard
     // error of each method is the spread of its RUNS independent runs (every random stream
     // changes with the seed) over sqrt(RUNS), and the two combine in quadrature. Pixel blocks
@@ -268,52 +180,6 @@ fn splatted_caustic_under_the_glass_sphere_matches_the_path_tracer() {
     assert!(za.abs().max_element() < 4.0, "whole image: z = {za}");
 }
 
-/// What the camera ray through `(x, y)` (pixel units) sees first, as a region name: a wall
-/// of the box (told by its material and which way it faces), one of the spheres, or `None`.
-fn seen(scene: &Scene, x: f32, y: f32) -> Option<&'static str> {
-    let ray = scene.camera.ray(x, y);
-    let hit = scene.geometry.intersect(&ray)?;
-    let name = scene.material_names[hit.material as usize].as_str();
-    if let Prim::Sphere(_) = hit.prim {
-        return match name {
-            "glass" => Some("glass sphere"),
-            "silver" => Some("silver sphere"),
-            _ => None,
-        };
-    }
-    if scene.emission[hit.material as usize] != Vec3::ZERO {
-        return None;
-    }
-    let n = hit.point.n * -hit.point.n.dot(ray.d).signum();
-    match name {
-        "red" if n.x > 0.9 => Some("left wall"),
-        "green" if n.x < -0.9 => Some("right wall"),
-        "white" if n.z > 0.9 => Some("back wall"),
-        "white" if n.y > 0.9 => Some("floor"),
-        "white" if n.y < -0.9 => Some("ceiling"),
-        _ => None,
-    }
-}
-
-/// The pixels whose centre and four points near their corners all see what `keep` accepts.
-fn pixels_seeing(scene: &Scene, keep: impl Fn(&str) -> bool) -> Vec<(usize, usize)> {
-    let corners = [
-        (0.5, 0.5),
-        (0.02, 0.02),
-        (0.98, 0.02),
-        (0.02, 0.98),
-        (0.98, 0.98),
-    ];
-    rect([0, 0, RES as usize, RES as usize])
-        .into_iter()
-        .filter(|&(x, y)| {
-            corners
-                .iter()
-                .all(|(u, v)| seen(scene, x as f32 + u, y as f32 + v).is_some_and(&keep))
-        })
-        .collect()
-}
-
 #[test]
 fn path_without_its_caustics_plus_the_splat_is_the_path_tracer() {
     let runs = worksheet_runs();
@@ -337,23 +203,26 @@ fn path_without_its_caustics_plus_the_splat_is_the_path_tracer() {
     }
     let scene = worksheet(RES, 1, 1);
     let regions = [
-        ("image", rect([0, 0, RES as usize, RES as usize])),
+        ("image", rect(WHOLE)),
         ("caustic", rect(CAUSTIC_RECT)),
         (
             "walls",
-            pixels_seeing(&scene, |s| {
+            pixels_seeing(&scene, WHOLE, |s| {
                 s.ends_with("wall") || s == "floor" || s == "ceiling"
             }),
         ),
-        ("floor", pixels_seeing(&scene, |s| s == "floor")),
-        ("back wall", pixels_seeing(&scene, |s| s == "back wall")),
+        ("floor", pixels_seeing(&scene, WHOLE, |s| s == "floor")),
+        (
+            "back wall",
+            pixels_seeing(&scene, WHOLE, |s| s == "back wall"),
+        ),
         (
             "glass sphere",
-            pixels_seeing(&scene, |s| s == "glass sphere"),
+            pixels_seeing(&scene, WHOLE, |s| s == "glass sphere"),
         ),
         (
             "silver sphere",
-            pixels_seeing(&scene, |s| s == "silver sphere"),
+            pixels_seeing(&scene, WHOLE, |s| s == "silver sphere"),
         ),
     ];
     // Each region's mean per run; a method's standard error is the spread of its RUNS
@@ -425,7 +294,7 @@ fn splatting_keeps_a_bounded_number_of_chunks_alive_and_writes_no_photons() {
     let scene = worksheet(16, 1, 1);
     let threads = 2;
     let opts = PipelineOptions::new(threads);
-    let eyes = EyeIndex::new(eye::eye_vertices(
+    let eyes = receivers(eye::eye_vertices(
         &scene,
         &VertexOptions {
             spp: 1,
@@ -489,7 +358,7 @@ fn splatting_keeps_a_bounded_number_of_chunks_alive_and_writes_no_photons() {
         photons: Some(100_000),
         ..Overrides::default()
     };
-    let r = render_in(&scene, &o, Some(threads), dir.path());
+    let r = render(&scene, &o, dir.path(), Some(threads));
     let in_flight = r.info["splat_max_chunks_in_flight"].as_u64();
     assert!(
         in_flight.is_some_and(|n| n as usize <= opts.window),
@@ -593,9 +462,8 @@ fn hostile_scene(dir: &Path, camera: &str) -> Scene {
         .iter()
         .map(|m| format!("newmtl {m}\nKd 0.5 0.5 0.5\n"))
         .collect();
-    std::fs::write(dir.join("hostile.mtl"), mtl).unwrap_or_else(|e| panic!("{e}"));
-    std::fs::write(dir.join("hostile.obj"), HOSTILE_OBJ).unwrap_or_else(|e| panic!("{e}"));
-    Scene::from_toml(&dir.join("hostile.toml"), &text).unwrap_or_else(|e| panic!("{e}"))
+    let files = [("hostile.mtl", mtl.as_str()), ("hostile.obj", HOSTILE_OBJ)];
+    scene_in(dir, &files, "hostile.toml", &text)
 }
 
 #[test]
@@ -611,14 +479,8 @@ fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
         photons: Some(photons),
         ..Overrides::default()
     };
-    let img = layer(&render(&scene, &o, None), "caustic").clone();
-    let bad: Vec<(usize, [f32; 3])> = img
-        .data
-        .iter()
-        .enumerate()
-        .filter(|(_, p)| p.iter().any(|c| !c.is_finite() || *c < 0.0))
-        .map(|(i, p)| (i, *p))
-        .collect();
+    let img = layer(&render_uncached(&scene, &o, None), "caustic").clone();
+    let bad = bad_pixels(&img);
     assert!(bad.is_empty(), "pixels {bad:?}");
     let total: f64 = img.data.iter().map(|p| p[0] as f64).sum();
     assert!(total > 0.0 && total.is_finite(), "{total}");
@@ -658,18 +520,8 @@ fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
     // What makes it hostile, as the footprints' principal semi-axes before the clamps (the
     // singular values of [a b]) show: some photons focus to a point, some spread wide.
     let max_r = render::splat::max_radius(&scene, &SplatSettings::default());
-    let axes = |p: &CausticPhoton| {
-        let (a, b) = (
-            p.a - p.a.dot(p.normal) * p.normal,
-            p.b - p.b.dot(p.normal) * p.normal,
-        );
-        let (p2, q, r2) = (a.length_squared(), a.dot(b), b.length_squared());
-        let dev = (0.25 * (p2 - r2) * (p2 - r2) + q * q).sqrt();
-        let mean = 0.5 * (p2 + r2);
-        ((mean + dev).sqrt(), (mean - dev).max(0.0).sqrt())
-    };
-    let focused = ps.iter().filter(|p| axes(p).1 < 1e-3).count();
-    let wide = ps.iter().filter(|p| axes(p).0 > max_r).count();
+    let focused = ps.iter().filter(|p| footprint_axes(p).1 < 1e-3).count();
+    let wide = ps.iter().filter(|p| footprint_axes(p).0 > max_r).count();
     eprintln!("hostile: {focused} photons focused below 1e-3, {wide} wider than {max_r}");
 
     // Flux kept: splat the same photons onto eye vertices of weight 1 on a square grid over
@@ -698,18 +550,18 @@ fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
             spacing: H,
         })
         .collect();
-    let eyes = EyeIndex::new(grid);
+    let eyes = receivers(grid);
     let settings = SplatSettings::default();
     let max_r = render::splat::max_radius(&scene, &settings);
     let h2 = (H as f64).powi(2);
-    let mut scratch = render::splat::Scratch::default();
+    let mut scratch = density::splat::Scratch::default();
     let mut out = Vec::new();
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for p in &ps {
         out.clear();
-        let one = std::slice::from_ref(p);
-        let iso = settings.isotropic_radius;
-        render::splat::splat(&eyes, one, max_r, iso, &mut scratch, &mut out);
+        let one = [render::splat::splat_photon(p)];
+        let params = density::splat::SplatParams::new(max_r, settings.isotropic_radius);
+        density::splat::splat(&eyes, one, &params, &mut scratch, &mut out);
         let kept = out.iter().map(|(_, v)| v.max_element()).sum::<f64>() * h2
             / p.flux.max_element() as f64;
         (lo, hi) = (lo.min(kept), hi.max(kept));
@@ -753,9 +605,6 @@ fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
 fn splatting_is_bit_identical_on_one_and_two_threads() {
     let scene = worksheet(32, 1, 4);
     // 100 000 caustic paths: seven chunks, so two workers finish them out of order.
-    let bits = |img: &film::Image| -> Vec<[u32; 3]> {
-        img.data.iter().map(|p| p.map(f32::to_bits)).collect()
-    };
     for method in [Method::CausticSplat, Method::PathSplat] {
         let o = Overrides {
             method: Some(method),
@@ -763,8 +612,8 @@ fn splatting_is_bit_identical_on_one_and_two_threads() {
             photons: Some(100_000),
             ..Overrides::default()
         };
-        let one = render(&scene, &o, Some(1));
-        let two = render(&scene, &o, Some(2));
+        let one = render_uncached(&scene, &o, Some(1));
+        let two = render_uncached(&scene, &o, Some(2));
         assert_eq!(one.layers.len(), two.layers.len());
         for (a, b) in one.layers.iter().zip(&two.layers) {
             assert_eq!(a.name, b.name);
@@ -802,7 +651,7 @@ fn splatting_is_bit_identical_on_one_and_two_threads() {
                 pass: 1,
             },
         );
-        let eyes = EyeIndex::new(vertices.clone());
+        let eyes = receivers(vertices.clone());
         let splatter = Splatter {
             scene: &scene,
             params: &params,

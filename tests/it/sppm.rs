@@ -1,30 +1,22 @@
-//! Stochastic progressive photon mapping end to end (issue 10), through
+//! Stochastic progressive photon mapping end to end, through
 //! `render::methods::render`: on scenes with a closed-form answer the estimate converges to
 //! it at the rate its radius schedule predicts, its snapshots are the images a shorter run
 //! makes, and its images are the same bit for bit on 1 and 2 threads.
 
+use crate::kit::{bits, layer_in, pixel, rect, render_uncached, scene_at};
 use glam::DVec3;
 use math::analytic::polygon_irradiance;
-use render::methods::CountKind;
+use render::rendered::CountKind;
 use render::{Overrides, Rendered};
 use scene::{Method, Scene};
-use std::path::Path;
-use tests::scenes_dir;
 
 /// `rel` from `scenes/` with seed `seed` and `[estimate.sppm]` (and anything else) from
 /// `extra`, a TOML table body applied over the file's.
 fn scene_with(rel: &str, seed: u64, res: u32, sppm: &str) -> Scene {
-    let path = scenes_dir().join(rel);
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{e}"));
     let table: toml::Table = sppm.parse().unwrap_or_else(|e| panic!("{e}"));
-    Scene::from_toml_with(&path, &text, |f| {
-        f.seed = seed;
-        f.camera.width = res;
-        f.camera.height = res;
-        f.estimate
-            .insert("sppm".into(), toml::Value::Table(table.clone()));
+    scene_at(rel, res, seed, |f| {
+        f.estimate.insert("sppm".into(), toml::Value::Table(table));
     })
-    .unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn render(scene: &Scene, passes: u32, threads: Option<usize>) -> Rendered {
@@ -41,19 +33,12 @@ fn render_method(scene: &Scene, method: Method, passes: u32, threads: Option<usi
         splat_photons: Some(20_000),
         ..Overrides::default()
     };
-    render_with(scene, &o, threads)
-}
-
-/// What the method `o` names renders (these methods read no photon cache).
-fn render_with(scene: &Scene, o: &Overrides, threads: Option<usize>) -> Rendered {
-    let cache = Path::new("/nonexistent/photonflow-it-sppm-cache");
-    lab::evidence::render_image(scene, o, cache, threads)
-        .unwrap_or_else(|e| panic!("{e}"))
-        .1
+    // These methods read no photon cache.
+    render_uncached(scene, &o, threads)
 }
 
 /// The layers of a snapshot (or of the run, `passes = None`).
-fn layers_at(r: &Rendered, passes: Option<u32>) -> &[render::methods::Layer] {
+fn layers_at(r: &Rendered, passes: Option<u32>) -> &[render::Layer] {
     match passes {
         None => &r.layers,
         Some(p) => {
@@ -75,19 +60,15 @@ fn image(r: &Rendered, passes: Option<u32>) -> film::Image {
     film::composite(&parts).unwrap_or_else(|e| panic!("{e}"))
 }
 
-fn pixel(img: &film::Image, (x, y): (usize, usize)) -> f64 {
-    // Grey scenes: the mean of the channels.
-    img.get(x, y).iter().map(|&c| c as f64).sum::<f64>() / 3.0
+/// Grey scenes: the mean of the pixel's channels.
+fn grey(img: &film::Image, p: (usize, usize)) -> f64 {
+    let v = pixel(img, p);
+    (v.x + v.y + v.z) / 3.0
 }
 
 /// One layer of a snapshot (or of the run).
-fn layer(r: &Rendered, passes: Option<u32>, name: &str) -> film::Image {
-    layers_at(r, passes)
-        .iter()
-        .find(|l| l.name == name)
-        .unwrap_or_else(|| panic!("no layer {name}"))
-        .image
-        .clone()
+fn layer<'a>(r: &'a Rendered, passes: Option<u32>, name: &str) -> &'a film::Image {
+    layer_in(layers_at(r, passes), name)
 }
 
 /// What [`convergence`] measures.
@@ -122,10 +103,10 @@ fn convergence(
         let all = image(&r, None);
         let mut run_mean = 0.0;
         for ((&p, &ep), &e) in pixels.iter().zip(exact_photons).zip(exact) {
-            sq_from += (pixel(&early, p) / ep - 1.0).powi(2);
-            sq_to += (pixel(&late, p) / ep - 1.0).powi(2);
+            sq_from += (grey(early, p) / ep - 1.0).powi(2);
+            sq_to += (grey(late, p) / ep - 1.0).powi(2);
             n += 1.0;
-            run_mean += (pixel(&all, p) / e - 1.0) / pixels.len() as f64;
+            run_mean += (grey(&all, p) / e - 1.0) / pixels.len() as f64;
         }
         run_means.push(run_mean);
     }
@@ -202,9 +183,7 @@ fn sppm_under_a_square_light_converges_to_the_polygon_irradiance() {
         [-0.25, 2.0, 0.25],
     ]
     .map(DVec3::from_array);
-    let pixels: Vec<(usize, usize)> = (28..36)
-        .flat_map(|y| (16..24).map(move |x| (x, y)))
-        .collect();
+    let pixels = rect([16, 28, 24, 36]);
     let exact: Vec<f64> = pixels
         .iter()
         .map(|&(x, y)| {
@@ -248,7 +227,7 @@ fn sppm_in_the_furnace_converges_to_le_over_one_minus_rho() {
     let scene = make(1);
     let mesh = scene.geometry.mesh();
     let area: f64 = (0..mesh.len()).map(|t| mesh.area(t) as f64).sum();
-    let pixels: Vec<(usize, usize)> = (5..11).flat_map(|y| (5..11).map(move |x| (x, y))).collect();
+    let pixels = rect([5, 5, 11, 11]);
     let m0 = vec![PHOTONS / area * std::f64::consts::PI * RADIUS * RADIUS; pixels.len()];
     let c = convergence(
         make,
@@ -263,9 +242,6 @@ fn sppm_in_the_furnace_converges_to_le_over_one_minus_rho() {
 #[test]
 fn sppm_snapshots_are_shorter_runs_and_threads_change_no_bit() {
     let scene = scene_with("cornell-spheres/analytic.toml", 3, 32, "photons = 20000\n");
-    let bits = |img: &film::Image| -> Vec<[u32; 3]> {
-        img.data.iter().map(|p| p.map(f32::to_bits)).collect()
-    };
     let long = render(&scene, 8, Some(2));
     let short = render(&scene, 4, Some(1));
     let passes: Vec<u32> = long.snapshots.iter().map(|s| s.passes).collect();
@@ -303,9 +279,6 @@ fn every_progressive_method_snapshots_what_a_shorter_run_makes() {
     // samples, with as many splatting passes), the one at 4 the image of a 4-pass run on
     // another thread count, bit for bit.
     let scene = scene_with("cornell-spheres/analytic.toml", 5, 24, "photons = 20000\n");
-    let bits = |img: &film::Image| -> Vec<[u32; 3]> {
-        img.data.iter().map(|p| p.map(f32::to_bits)).collect()
-    };
     for method in [Method::Path, Method::CausticSplat, Method::PathSplat] {
         let long = render_method(&scene, method, 8, Some(2));
         let short = render_method(&scene, method, 4, Some(1));
@@ -333,11 +306,11 @@ fn a_time_budget_stops_after_the_pass_that_reaches_it() {
     };
     // The path tracer: passes of 1, 1, 2, 4, ... samples, so the first pass makes one
     // sample per pixel, recorded as the spp made.
-    let r = render_with(&scene, &budget(Method::Path, 4096), None);
+    let r = render_uncached(&scene, &budget(Method::Path, 4096), None);
     assert_eq!(r.samples, Some(1));
     assert!(r.layers.iter().all(|l| l.count == 1));
     // SPPM: exactly one pass is made, and recorded.
-    let r = render_with(&scene, &budget(Method::Sppm, 1000), None);
+    let r = render_uncached(&scene, &budget(Method::Sppm, 1000), None);
     assert_eq!(r.passes, Some(1));
     assert_eq!(r.snapshots.len(), 1);
 }

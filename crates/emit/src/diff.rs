@@ -224,7 +224,3 @@ pub fn mesh_dn(dx: Vec3, p: [Vec3; 3], ns: [Vec3; 3], b: [f32; 3]) -> Vec3 {
     let dbig_n = db1 * (ns[1] - ns[0]) + db2 * (ns[2] - ns[0]);
     (dbig_n - n * n.dot(dbig_n)) / len
 }
-
-#[cfg(test)]
-#[path = "diff_tests.rs"]
-mod tests;

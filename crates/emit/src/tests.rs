@@ -13,6 +13,9 @@ use scene::{Material, SPHERE_BIT, Scene};
 use std::path::{Path, PathBuf};
 use store::MapKind;
 
+// The photon differentials' tests (against finite differences) live in tests/diff.rs.
+mod diff;
+
 fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
 }

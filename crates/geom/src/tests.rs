@@ -5,6 +5,10 @@ use crate::{BvhKind, Geometry, Prim, Ray, Sphere, SurfacePoint, TriMesh, smooth_
 use glam::{DVec3, Vec3};
 use math::Rng;
 
+// The BVH4 collapse and SIMD lane tests live in tests/ (one file per module).
+mod bvh4;
+mod simd;
+
 fn rand_vec(rng: &mut Rng, lo: f32, hi: f32) -> Vec3 {
     Vec3::new(
         lo + (hi - lo) * rng.uniform(),

@@ -90,3 +90,79 @@ fn peer_ray_rates_are_read_from_their_lines() {
         None
     );
 }
+
+// --- The benchmarks' ray files -------------------------------------------------------------
+
+mod ray_files {
+    use crate::bench::*;
+
+    fn tmp(name: &str) -> std::path::PathBuf {
+        let d = std::env::temp_dir().join(format!("pf-rayfile-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d.join(name)
+    }
+
+    #[test]
+    fn ray_file_round_trips_and_bad_lengths_name_the_file() {
+        let rows = [
+            [1.0f32, -2.5, 3.0, 0.0, -1.0, 0.0],
+            [0.1, 0.2, 0.3, 0.6, 0.0, 0.8],
+        ];
+        let bytes: Vec<u8> = rows
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let p = tmp("ok_rays.f32");
+        std::fs::write(&p, &bytes).unwrap();
+        let rays = read_ray_file(&p).unwrap();
+        assert_eq!(rays.len(), 2);
+        for (r, w) in rays.iter().zip(&rows) {
+            assert_eq!(r.o.to_array(), [w[0], w[1], w[2]]);
+            assert_eq!(r.d.to_array(), [w[3], w[4], w[5]]);
+            assert_eq!(r.t_max, f32::INFINITY);
+        }
+        let short = tmp("short_rays.f32");
+        std::fs::write(&short, &bytes[..bytes.len() - 1]).unwrap();
+        let e = read_ray_file(&short).unwrap_err();
+        assert!(
+            e.contains("short_rays.f32") && e.contains("47 bytes"),
+            "{e}"
+        );
+        std::fs::write(&short, []).unwrap();
+        assert!(read_ray_file(&short).is_err());
+        assert!(
+            read_ray_file(&tmp("missing.f32"))
+                .unwrap_err()
+                .contains("missing.f32")
+        );
+    }
+
+    fn npy(descr: &str, shape: &str, data: &[f32]) -> Vec<u8> {
+        let mut h = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+        while (10 + h.len() + 1) % 64 != 0 {
+            h.push(' ');
+        }
+        h.push('\n');
+        let mut b = b"\x93NUMPY\x01\x00".to_vec();
+        b.extend((h.len() as u16).to_le_bytes());
+        b.extend(h.bytes());
+        b.extend(data.iter().flat_map(|v| v.to_le_bytes()));
+        b
+    }
+
+    #[test]
+    fn npy_reader_reads_f32_vectors_and_rejects_others() {
+        let data = [1.5f32, f32::INFINITY, 0.25];
+        let p = tmp("t.npy");
+        std::fs::write(&p, npy("<f4", "(3,)", &data)).unwrap();
+        assert_eq!(read_npy_f32(&p).unwrap(), data);
+        for (descr, shape, n) in [("<i4", "(3,)", 3), ("<f4", "(4,)", 3), ("<f4", "(3, 1)", 3)] {
+            std::fs::write(&p, npy(descr, shape, &data[..n])).unwrap();
+            let e = read_npy_f32(&p).unwrap_err();
+            assert!(e.contains("t.npy"), "{e}");
+        }
+        std::fs::write(&p, b"not numpy").unwrap();
+        assert!(read_npy_f32(&p).is_err());
+    }
+}

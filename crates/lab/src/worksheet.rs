@@ -292,7 +292,7 @@ pub fn run(scene: &Scene, a: &WorksheetArgs) -> Result<(), String> {
             md,
             "| [{n}]({n}/image.png) | {} | {} | {} | {secs:.2} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} |",
             v.title,
-            v.kernel.to_string(),
+            v.kernel,
             v.topo.map_or("off".to_string(), |e| format!("eps = {e}"))
                 + if v.boundary {
                     ", boundary corrected"

@@ -160,21 +160,6 @@ const fn sobol1_tables() -> [[u32; 256]; 4] {
     t
 }
 
-/// The bit loop [`sobol1`]'s tables are built from, kept for the test that checks them.
-#[cfg(test)]
-pub fn sobol1_by_bits(mut i: u32) -> u32 {
-    let mut v = 1u32 << 31;
-    let mut x = 0;
-    while i != 0 {
-        if i & 1 != 0 {
-            x ^= v;
-        }
-        i >>= 1;
-        v ^= v >> 1;
-    }
-    x
-}
-
 /// A hash that permutes bits only downwards (each output bit depends on itself and lower
 /// bits): Laine and Karras 2011's construction with Burley 2020's constants (his Listing 4).
 #[inline]

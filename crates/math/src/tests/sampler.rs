@@ -1,4 +1,4 @@
-use crate::sampler::{nested_uniform_scramble, sobol0, sobol1, sobol1_by_bits};
+use crate::sampler::{nested_uniform_scramble, sobol0, sobol1};
 use crate::{Rng, Sampler, SobolSampler};
 
 /// Whether points (in 32-bit fixed point) form a (0,m,2)-net: every elementary interval of
@@ -110,6 +110,21 @@ fn a_smooth_integral_converges_faster_than_with_independent_samples() {
         e_sobol < 0.1 * e_indep,
         "sobol {e_sobol}, independent {e_indep}"
     );
+}
+
+/// The bit loop [`sobol1`]'s tables are built from: the generator matrix times the index,
+/// one direction number per set bit.
+fn sobol1_by_bits(mut i: u32) -> u32 {
+    let mut v = 1u32 << 31;
+    let mut x = 0;
+    while i != 0 {
+        if i & 1 != 0 {
+            x ^= v;
+        }
+        i >>= 1;
+        v ^= v >> 1;
+    }
+    x
 }
 
 #[test]

@@ -2,11 +2,12 @@
 //! trace the perturbed rays exactly (f64 ray–plane, ray–sphere, Snell), and compare the
 //! central differences with the propagated derivatives (Igehy 1999 §4 validates the same way).
 
-use super::*;
-use glam::DVec3;
+use super::load;
+use crate::diff::{
+    MIN_EMIT_COS, RayDiff, emit_diff, mesh_dn, reflect_diff, refract_diff, sphere_dn, transfer,
+};
+use glam::{DVec3, Vec3};
 use math::Rng;
-use scene::Scene;
-use std::path::Path;
 
 /// Parameter step of the central differences: the derivatives are O(0.05), so `h` moves a
 /// ray by ~5e-6, 1e-4 of its footprint; f64 tracing keeps rounding far below the O(h²)
@@ -372,9 +373,7 @@ fn total_internal_reflection_gives_none() {
 
 #[test]
 fn emission_footprints_are_the_photons_share_of_area_and_solid_angle() {
-    let path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-spheres/analytic.toml");
-    let scene = Scene::load(path).unwrap_or_else(|e| panic!("{e}"));
+    let scene = load("cornell-spheres/analytic.toml");
     let lights = scene.light_table.clone();
     // The Cornell light: two triangles chosen by power = by area (one radiance).
     let area: f64 = (0..lights.len()).map(|i| lights.area(i) as f64).sum();
