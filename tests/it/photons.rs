@@ -4,8 +4,9 @@
 
 use crate::kit::{Mean, load, scenes_dir};
 use bsdf::TransportMode;
-use emit::{EmitParams, Plan, chunks, trace_parallel, trace_range};
+use emit::{EmitParams, Plan, trace_parallel, trace_range};
 use eye::{Class, PathOptions, PathTracer};
+use flow::chunks;
 use geom::{Hit, Prim, Ray};
 use glam::{DVec3, Vec2, Vec3};
 use math::warp::{sample_cosine_hemisphere, sample_uniform_disk_concentric};

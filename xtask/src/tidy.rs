@@ -21,7 +21,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("film", &[]),
     ("store", &["math"]),
     ("eye", &["math", "geom", "scene", "bsdf", "film"]),
-    ("emit", &["math", "geom", "scene", "bsdf", "store"]),
+    ("emit", &["math", "geom", "scene", "bsdf", "store", "flow"]),
     (
         "density",
         &["math", "geom", "scene", "bsdf", "film", "store"],

@@ -38,7 +38,7 @@ pub use caustic::{CausticPhoton, pass_stream, trace_caustics};
 pub use diff::{RayDiff, emit_diff, mesh_dn, reflect_diff, refract_diff, sphere_dn, transfer};
 pub use params::EmitParams;
 pub use plan::{Plan, PlanError};
-pub use trace::{EMIT_STREAM, Traced, chunks, trace_parallel, trace_pass, trace_range};
+pub use trace::{EMIT_STREAM, Traced, trace_parallel, trace_pass, trace_range};
 
 #[cfg(test)]
 mod tests;

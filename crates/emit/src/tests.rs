@@ -2,9 +2,7 @@
 //! conservation in a closed box, caustic classification in the worksheet scene, determinism
 //! over any split, and the emission distribution against its pdf.
 
-use crate::{
-    EMIT_STREAM, EmitParams, Plan, PlanError, Traced, chunks, trace_parallel, trace_range,
-};
+use crate::{EMIT_STREAM, EmitParams, Plan, PlanError, Traced, trace_parallel, trace_range};
 use glam::DVec3;
 use math::chi2::{chi2_test, pearson};
 use math::warp::cosine_hemisphere_pdf;
@@ -380,7 +378,7 @@ fn russian_roulette_keeps_the_expected_flux_in_a_closed_box() {
     let one = DVec3::ONE;
     let expected = power * (one - rho.powf(d)) / (one - rho);
     // Standard error from the spread of 40 independent batches of 1000 paths.
-    let batches: Vec<DVec3> = chunks(p.photons, 1000)
+    let batches: Vec<DVec3> = flow::chunks(p.photons, 1000)
         .map(|r| sum_power(&trace_range(&scene, &p, &pl, r)[MapKind::Global]))
         .collect();
     let k = batches.len() as f64;
@@ -525,7 +523,7 @@ fn any_split_of_the_paths_gives_the_same_photons() {
         assert_eq!(joined, whole, "cuts {cuts:?}");
     }
     let mut joined = Traced::default();
-    for r in chunks(p.photons, 256) {
+    for r in flow::chunks(p.photons, 256) {
         joined.append(trace_range(&scene, &p, &pl, r));
     }
     assert_eq!(joined, whole);
@@ -591,15 +589,6 @@ fn the_seed_selects_the_photons() {
 }
 
 // --- Small pieces ----------------------------------------------------------------------------
-
-#[test]
-fn chunks_cover_the_range_in_order() {
-    let c = |t, n| chunks(t, n).collect::<Vec<_>>();
-    assert_eq!(c(10, 3), vec![0..3, 3..6, 6..9, 9..10]);
-    assert_eq!(c(6, 3), vec![0..3, 3..6]);
-    assert_eq!(c(2, 5), vec![0..2]);
-    assert!(c(0, 5).is_empty());
-}
 
 #[test]
 fn params_round_trip_and_reject_unknown_keys() {

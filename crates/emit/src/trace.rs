@@ -45,13 +45,6 @@ impl std::ops::Index<MapKind> for Traced {
     }
 }
 
-/// `0..total` cut into consecutive ranges of `chunk` paths (the last may be shorter): units of
-/// work whose [`trace_range`] results concatenate to the whole run.
-pub fn chunks(total: u64, chunk: u64) -> impl Iterator<Item = Range<u64>> {
-    assert!(chunk > 0, "chunk size must be positive");
-    (0..total.div_ceil(chunk)).map(move |k| k * chunk..((k + 1) * chunk).min(total))
-}
-
 /// Trace photon paths `range` (indices into `0..params.photons`) in increasing order. Path `i`
 /// draws its numbers from `Rng::for_index(scene.seed() ^ EMIT_STREAM, i)` only, so the result
 /// for a range is the concatenation of the results for any split of it.
@@ -114,7 +107,7 @@ pub fn trace_pass(
 /// [`trace_range`] over `0..params.photons` on rayon's current thread pool, `chunk` paths per
 /// task, concatenated in index order: the same photons as one call to [`trace_range`].
 pub fn trace_parallel(scene: &Scene, params: &EmitParams, plan: &Plan, chunk: u64) -> Traced {
-    let parts: Vec<Traced> = chunks(params.photons, chunk)
+    let parts: Vec<Traced> = flow::chunks(params.photons, chunk)
         .collect::<Vec<_>>()
         .into_par_iter()
         .map(|r| trace_range(scene, params, plan, r))

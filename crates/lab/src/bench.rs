@@ -388,7 +388,7 @@ pub fn photons(path: &Path, count: u64, runs: usize) -> Result<(), String> {
         let mut stored = 0;
         for _ in 0..runs.max(1) {
             let t = Instant::now();
-            let chunks: Vec<_> = emit::chunks(count, 16_384).collect();
+            let chunks: Vec<_> = flow::chunks(count, 16_384).collect();
             let traced: Vec<emit::Traced> = pool.install(|| {
                 use rayon::prelude::*;
                 chunks
