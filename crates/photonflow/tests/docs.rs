@@ -139,3 +139,35 @@ fn render_without_method_renders_the_documented_default() {
     let (default, _) = readme_default_and_methods();
     assert_eq!(json["method"], default.as_str());
 }
+
+/// `estimate` without `--method` on a scene whose method reads no photon maps runs the
+/// default README documents, from the photon sets a `trace` cached.
+#[test]
+fn estimate_without_method_runs_the_documented_default() {
+    let readme = read("README.md");
+    assert!(
+        readme.contains(&format!("else `{ESTIMATE_DEFAULT}`")),
+        "README names another estimate default than {ESTIMATE_DEFAULT}"
+    );
+    let scene = root().join("scenes/furnace/furnace.toml");
+    let out = std::env::temp_dir().join(format!("photonflow-estimate-{}", std::process::id()));
+    let cache = out.join("cache");
+    let (s, c) = (scene.to_str().unwrap(), cache.to_str().unwrap());
+    let common = ["--photons", "2000", "--threads", "1", "--cache", c];
+    let (code, err) =
+        photonflow::run_args([["photonflow", "trace", s].as_slice(), &common].concat());
+    assert_eq!(code, 0, "{err:?}");
+    let run = out.join("run");
+    let (code, err) = photonflow::run_args(
+        [
+            ["photonflow", "estimate", s, "--out", run.to_str().unwrap()].as_slice(),
+            &common,
+        ]
+        .concat(),
+    );
+    assert_eq!(code, 0, "{err:?}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("image.json")).unwrap()).unwrap();
+    let _ = std::fs::remove_dir_all(&out);
+    assert_eq!(json["method"], ESTIMATE_DEFAULT.name().as_str());
+}
