@@ -225,6 +225,12 @@ fn the_report_links_resolve_and_a_browser_shows_its_images() {
     std::fs::rename(out.join("moved.png"), out.join("images/reference.png")).unwrap();
 
     let Some(exe) = chromium() else {
+        // CI sets this: there the check must run, so a missing Chromium fails it.
+        assert!(
+            std::env::var_os("PHOTONFLOW_REQUIRE_CHROMIUM").is_none(),
+            "PHOTONFLOW_REQUIRE_CHROMIUM is set but Chromium is not installed (apt-get install \
+             chromium, or set CHROMIUM): the report's browser check cannot run"
+        );
         eprintln!("Chromium not installed (apt-get install chromium): browser check skipped");
         return;
     };

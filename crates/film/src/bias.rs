@@ -42,6 +42,27 @@ impl BiasVariance {
         reference: &Image,
         relative: bool,
     ) -> Result<BiasVariance, FilmError> {
+        BiasVariance::with_reference_variance(runs, reference, None, relative)
+    }
+
+    /// As [`BiasVariance::new`] against the mean of two halves (`crate::Halves`): the
+    /// reference's variance is taken out of each bias² as the runs' own variance of the mean
+    /// is, so the reference's noise no longer reads as bias. Pixels' bias² may then be
+    /// negative (unbiased estimates of a small bias²); maps show them as zero.
+    pub fn against_halves(
+        runs: &[&Image],
+        halves: &crate::Halves,
+        relative: bool,
+    ) -> Result<BiasVariance, FilmError> {
+        BiasVariance::with_reference_variance(runs, &halves.mean, Some(&halves.variance), relative)
+    }
+
+    fn with_reference_variance(
+        runs: &[&Image],
+        reference: &Image,
+        reference_variance: Option<&[[f64; 3]]>,
+        relative: bool,
+    ) -> Result<BiasVariance, FilmError> {
         let (w, h) = (reference.width, reference.height);
         for r in runs {
             if (r.width, r.height) != (w, h) {
@@ -76,7 +97,17 @@ impl BiasVariance {
                     let s2 = vals.clone().map(|a| (a - m) * (a - m)).sum::<f64>() / (kf - 1.0);
                     let sq = vals.map(|a| (a - rc) * (a - rc)).sum::<f64>() / kf;
                     m_rgb[c] = m as f32;
-                    b += ((m - rc).powi(2) - s2 / kf).max(0.0) * weight;
+                    // E[(m - ref)²] = bias² + Var(m) + Var(ref): both variances out.
+                    let var_ref = reference_variance.map_or(0.0, |v| v[y * w + x][c]);
+                    let b2 = (m - rc).powi(2) - s2 / kf - var_ref;
+                    // Against halves the per-pixel estimate is left unclamped: the halves'
+                    // variance estimate is too noisy per pixel (one degree of freedom) for
+                    // a clamp at zero not to read as bias, and region means stay unbiased.
+                    b += if reference_variance.is_some() {
+                        b2
+                    } else {
+                        b2.max(0.0)
+                    } * weight;
                     v += s2 * weight;
                     e += sq * weight;
                 }

@@ -714,3 +714,104 @@ fn class_all_is_sorted_and_lists_each_class_once() {
     let caustic: Vec<Class> = Class::ALL.into_iter().filter(|c| c.is_caustic()).collect();
     assert_eq!(caustic, [Class::Caustic, Class::CausticIndirect]);
 }
+
+// ---- a reference as two halves
+
+/// Gaussian noise from a fixed stream (Box-Muller over splitmix64), for synthetic images.
+fn gaussian_stream(seed: u64) -> impl FnMut() -> f64 {
+    let mut s = seed;
+    let mut uniform = move || {
+        s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = s;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        (((z ^ (z >> 31)) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    };
+    move || (-2.0 * uniform().ln()).sqrt() * (std::f64::consts::TAU * uniform()).cos()
+}
+
+/// Synthetic images with known noise: truth T = 1, halves of standard deviation 0.03, an image
+/// of standard deviation 0.05 (and a bias of 0.03 on its left half). Against the halves' mean
+/// its plain MSE carries the reference's variance 0.03²/2 = 0.00045 (15% of its own); with
+/// the halves' variance taken out it is its error against the truth.
+#[test]
+fn halves_take_the_references_noise_out_of_the_errors() {
+    let (w, h) = (256, 256);
+    let (sigma_ref, sigma, bias) = (0.03, 0.05, 0.03);
+    let mut g = gaussian_stream(7);
+    let mut noisy = |s: f64, b: &dyn Fn(usize) -> f64| {
+        Image::from_fn(w, h, |x, _| {
+            [0, 1, 2].map(|_| (1.0 + b(x) + s * g()) as f32)
+        })
+    };
+    let a = noisy(sigma_ref, &|_| 0.0);
+    let b = noisy(sigma_ref, &|_| 0.0);
+    let img = noisy(sigma, &|x| if x < w / 2 { bias } else { 0.0 });
+    let truth = constant(w, h, 1.0);
+    let halves = Halves::new(&a, &b).unwrap();
+    let against_truth = metrics(&img, &truth, None).unwrap();
+    let m = metrics_halves(&img, &halves, None).unwrap();
+    // Against the truth: MSE = sigma² + bias²/2 = 0.0025 + 0.00045 = 0.00295.
+    let mse_truth = sigma * sigma + bias * bias / 2.0;
+    assert!((against_truth.rmse.powi(2) / mse_truth - 1.0).abs() < 0.02);
+    // The plain MSE against the halves' mean adds their variance, 0.00045.
+    let plain = m.plain.rmse.powi(2);
+    let with_ref = mse_truth + sigma_ref * sigma_ref / 2.0;
+    assert!((plain / with_ref - 1.0).abs() < 0.02, "plain {plain}");
+    // Taken out: the MSE against the truth. Per element, d² - v has standard deviation about
+    // 0.0048, so 1.1e-5 over 196608 values: 5e-5 is 4.5 of those.
+    let corrected = m.rmse.powi(2);
+    assert!(
+        (corrected - mse_truth).abs() < 5e-5,
+        "corrected {corrected}, truth {mse_truth}"
+    );
+    // The relative MSE likewise. Its weights 1/(R² + 0.01) share R's noise with the error,
+    // which adds about 3 Var(R) MSE + 4 bias Var(R) (Taylor in R's noise): 1% here.
+    assert!(
+        (m.relmse / against_truth.relmse - 1.0).abs() < 0.025,
+        "{} vs {}",
+        m.relmse,
+        against_truth.relmse
+    );
+    assert!(m.plain.relmse > 1.1 * against_truth.relmse);
+    assert!((m.plain.relmse - m.relmse - m.reference_relmse).abs() < 1e-12);
+    assert!((m.reference_relmse / (0.00045 / 1.01) - 1.0).abs() < 0.02);
+}
+
+/// Bias² maps against halves: the reference's noise no longer reads as bias where there is
+/// none, and a real bias is still measured.
+#[test]
+fn bias_maps_against_halves_count_the_references_noise_out() {
+    let (w, h, k) = (64, 64, 8);
+    let (sigma_ref, sigma, bias) = (0.1, 0.05, 0.1);
+    let mut g = gaussian_stream(11);
+    let mut noisy =
+        |s: f64, b: f64| Image::from_fn(w, h, |_, _| [0, 1, 2].map(|_| (1.0 + b + s * g()) as f32));
+    let a = noisy(sigma_ref, 0.0);
+    let b = noisy(sigma_ref, 0.0);
+    let unbiased: Vec<Image> = (0..k).map(|_| noisy(sigma, 0.0)).collect();
+    let biased: Vec<Image> = (0..k).map(|_| noisy(sigma, bias)).collect();
+    let halves = Halves::new(&a, &b).unwrap();
+    let region = |runs: &[Image], corrected: bool| {
+        let refs: Vec<&Image> = runs.iter().collect();
+        let bv = if corrected {
+            BiasVariance::against_halves(&refs, &halves, false).unwrap()
+        } else {
+            BiasVariance::new(&refs, &halves.mean, false).unwrap()
+        };
+        bv.region(None).unwrap().bias2
+    };
+    // Plain: the reference's variance 0.005 reads as bias² (minus the clamp's share).
+    let plain = region(&unbiased, false);
+    assert!(plain > 0.003, "plain bias² of unbiased runs {plain}");
+    // Corrected: zero within its standard error. Per pixel and channel, (m - R)² - s²/K - v
+    // has standard deviation about 0.008 here, so 1.4e-4 over 4096 pixels' 3 channels.
+    let corrected = region(&unbiased, true);
+    assert!(
+        corrected.abs() < 5e-4,
+        "corrected {corrected}, plain {plain}"
+    );
+    // A real bias of 0.1 (bias² 0.01) is still there.
+    let real = region(&biased, true);
+    assert!((real / (bias * bias) - 1.0).abs() < 0.15, "{real}");
+}
