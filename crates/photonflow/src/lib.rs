@@ -235,10 +235,14 @@ enum Cmd {
         #[arg(long, default_value_t = 0.0, value_parser = parse_finite)]
         exposure: f32,
     },
-    /// Error metrics of image A against reference B (linear EXR files).
+    /// Error metrics of image A against reference B (linear EXR files); given a second
+    /// reference B2, an independent half of the same budget with another seed, against the
+    /// halves' mean with the reference's own noise taken out ((B - B2)²/4 per pixel), the plain
+    /// figures beside.
     Compare {
         a: PathBuf,
         b: PathBuf,
+        b2: Option<PathBuf>,
         /// Restrict to the pixel rectangle x0,y0,x1,y1 (half open).
         #[arg(long, value_parser = parse_rect)]
         mask: Option<[usize; 4]>,
@@ -594,10 +598,21 @@ fn run(cmd: Cmd) -> Result<(), String> {
             out,
             exposure,
         } => composite::run(&inputs, &out, exposure),
-        Cmd::Compare { a, b, mask } => {
-            let m = render::output::compare(&a, &b, mask)?;
-            let flip = render::output::compare_flip(&a, &b, mask)?;
-            println!("{m} flip={flip:.5}");
+        Cmd::Compare { a, b, b2, mask } => {
+            let img = render::output::read_finite(&a)?;
+            let (text, reference) = match b2 {
+                Some(b2) => {
+                    let (m, mean) = render::output::compare_halves(&a, &b, &b2, mask)?;
+                    (m.to_string(), mean)
+                }
+                None => (
+                    render::output::compare(&a, &b, mask)?.to_string(),
+                    render::output::read_finite(&b)?,
+                ),
+            };
+            let flip = render::output::compare_flip(&img, &reference, mask)
+                .map_err(|e| format!("{}: {e}", a.display()))?;
+            println!("{text} flip={flip:.5}");
             Ok(())
         }
         Cmd::BenchPhotons {

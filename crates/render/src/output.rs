@@ -191,55 +191,78 @@ fn remove_if_present(p: &Path) -> Result<(), String> {
     }
 }
 
-/// Mean LDR-FLIP of image `a` against reference `b` (linear EXR files; exposure 1, gamma
-/// 2.2, `film::flip`), inside `mask`.
-pub fn compare_flip(a: &Path, b: &Path, mask: Option<[usize; 4]>) -> Result<f64, String> {
-    let ia = film::read_exr(a).map_err(|e| e.to_string())?;
-    let ib = film::read_exr(b).map_err(|e| e.to_string())?;
-    let mask = mask.map(|[x0, y0, x1, y1]| Mask::rect(ia.width, ia.height, x0, y0, x1, y1));
-    let map = film::flip(&ia, &ib, 1.0).map_err(|e| e.to_string())?;
+/// FLIP of image `a` against the reference `b` inside `mask` (a rectangle, as `compare`'s).
+pub fn compare_flip(a: &Image, b: &Image, mask: Option<[usize; 4]>) -> Result<f64, String> {
+    let mask = mask.map(|[x0, y0, x1, y1]| Mask::rect(a.width, a.height, x0, y0, x1, y1));
+    let map = film::flip(a, b, 1.0).map_err(|e| e.to_string())?;
     map.mean(mask.as_ref())
         .map_err(|e| e.to_string())?
-        .ok_or_else(|| format!("{}: the mask selects no pixel", a.display()))
+        .ok_or_else(|| "the mask selects no pixel".to_string())
 }
 
-/// Error metrics of image `a` against reference `b` (linear EXR files), inside `mask`.
-/// Refused: an image holding NaN or infinity (its errors would be NaN), and a mask that is
-/// empty or reaches outside the image (clipping it silently would measure another region).
-pub fn compare(a: &Path, b: &Path, mask: Option<[usize; 4]>) -> Result<film::Metrics, String> {
-    let ia = read_exr(a)?;
-    let ib = read_exr(b)?;
-    for (p, img) in [(a, &ia), (b, &ib)] {
-        let bad = img
-            .data
-            .iter()
-            .filter(|px| !px.iter().all(|c| c.is_finite()))
-            .count();
-        if bad > 0 {
-            return Err(format!(
-                "{}: {bad} of {} pixels are not finite (NaN or infinity): errors against it \
-                 are undefined",
-                p.display(),
-                img.data.len()
-            ));
-        }
+/// A linear EXR to compare, refused if it holds NaN or infinity (errors against it would be
+/// NaN).
+pub fn read_finite(p: &Path) -> Result<Image, String> {
+    let img = read_exr(p)?;
+    let bad = img
+        .data
+        .iter()
+        .filter(|px| !px.iter().all(|c| c.is_finite()))
+        .count();
+    if bad > 0 {
+        return Err(format!(
+            "{}: {bad} of {} pixels are not finite (NaN or infinity): errors against it are \
+             undefined",
+            p.display(),
+            img.data.len()
+        ));
     }
-    let mask = match mask {
+    Ok(img)
+}
+
+/// `mask` as a mask of `img` (read from `p`), refused when empty or reaching outside the image
+/// (clipping it silently would measure another region).
+pub fn mask_of(p: &Path, img: &Image, mask: Option<[usize; 4]>) -> Result<Option<Mask>, String> {
+    match mask {
         Some([x0, y0, x1, y1]) => {
-            if !(x0 < x1 && y0 < y1 && x1 <= ia.width && y1 <= ia.height) {
+            if !(x0 < x1 && y0 < y1 && x1 <= img.width && y1 <= img.height) {
                 return Err(format!(
                     "{}: --mask {x0},{y0},{x1},{y1} is not a non-empty rectangle inside the \
                      {}x{} image (x0 < x1 <= width, y0 < y1 <= height)",
-                    a.display(),
-                    ia.width,
-                    ia.height
+                    p.display(),
+                    img.width,
+                    img.height
                 ));
             }
-            Some(Mask::rect(ia.width, ia.height, x0, y0, x1, y1))
+            Ok(Some(Mask::rect(img.width, img.height, x0, y0, x1, y1)))
         }
-        None => None,
-    };
-    film::metrics(&ia, &ib, mask.as_ref()).map_err(|e| e.to_string())
+        None => Ok(None),
+    }
+}
+
+/// Error metrics of image `a` against reference `b` (linear EXR files), inside `mask`.
+pub fn compare(a: &Path, b: &Path, mask: Option<[usize; 4]>) -> Result<film::Metrics, String> {
+    let (ia, ib) = (read_finite(a)?, read_finite(b)?);
+    let mask = mask_of(a, &ia, mask)?;
+    film::metrics(&ia, &ib, mask.as_ref()).map_err(|e| format!("{}: {e}", b.display()))
+}
+
+/// Error metrics of image `a` against a reference given as two independent halves `b1` and
+/// `b2` (other seeds, one budget), plain and with the reference's noise taken out
+/// (`film::Halves`), inside `mask`; and the halves' mean, for FLIP.
+pub fn compare_halves(
+    a: &Path,
+    b1: &Path,
+    b2: &Path,
+    mask: Option<[usize; 4]>,
+) -> Result<(film::HalvesMetrics, Image), String> {
+    let ia = read_finite(a)?;
+    let halves = film::Halves::new(&read_finite(b1)?, &read_finite(b2)?)
+        .map_err(|e| format!("{} and {}: {e}", b1.display(), b2.display()))?;
+    let mask = mask_of(a, &ia, mask)?;
+    let m = film::metrics_halves(&ia, &halves, mask.as_ref())
+        .map_err(|e| format!("{}: {e}", b1.display()))?;
+    Ok((m, halves.mean))
 }
 
 /// Reads a linear EXR a user named, refusing anything but a regular file before opening it
