@@ -189,6 +189,7 @@ fn the_report_links_resolve_and_a_browser_shows_its_images() {
     lab::evidence(&lab::evidence::EvidenceArgs {
         scene,
         reference: None,
+        reference_b: None,
         reference_spp: 64,
         seeds: 2,
         quick: true,

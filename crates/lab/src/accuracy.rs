@@ -99,16 +99,47 @@ pub struct Peer {
     pub command: String,
 }
 
+/// The relative MSE of the image at `exr` with the reference's noise taken out, when the
+/// reference came as two halves (else nothing).
+fn corrected(halves: Option<&film::Halves>, exr: &Path) -> Result<String, String> {
+    let Some(h) = halves else {
+        return Ok(String::new());
+    };
+    let img = render::output::read_finite(exr)?;
+    let m = film::metrics_halves(&img, h, None).map_err(|e| format!("{}: {e}", exr.display()))?;
+    Ok(format!("  (reference noise out: {:.5})", m.relmse))
+}
+
+/// `bench accuracy`. `reference_b`: the second independent half of a given `reference`; the
+/// plain errors are then against the halves' mean, each with the reference's noise taken out
+/// beside it (time to the target stays on the plain figures, the path tracer's included).
 pub fn accuracy(
     path: &Path,
     given_reference: Option<&Path>,
+    reference_b: Option<&Path>,
     reference_spp: u32,
     peers: &[Peer],
     dir: &Path,
 ) -> Result<(), String> {
     let scene = Scene::load(path).map_err(|e| e.to_string())?;
-    let reference =
-        crate::reference::reference(&scene, given_reference, reference_spp, dir, None)?.exr;
+    let (reference, halves) = match (given_reference, reference_b) {
+        (Some(a), Some(b)) => {
+            let mean = dir.join("reference-halves-mean.exr");
+            let h = crate::reference::halves(&scene, a, b, &mean)?;
+            (mean, Some(h))
+        }
+        (None, Some(b)) => {
+            return Err(format!(
+                "--reference-b {}: the second half needs the first (--reference)",
+                b.display()
+            ));
+        }
+        _ => (
+            crate::reference::reference(&scene, given_reference, reference_spp, dir, None)?.exr,
+            None,
+        ),
+    };
+    let halves = halves.as_ref();
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let cache = dir.join("cache");
     let mut table: Vec<(String, Vec<Rung>)> = Vec::new();
@@ -125,7 +156,8 @@ pub fn accuracy(
                 Some(&reference),
                 &cache,
             )?;
-            println!("{name:<13} {b:>5} spp  {seconds:8.2} s  relMSE {relmse:.5}");
+            let c = corrected(halves, &out.join("image.exr"))?;
+            println!("{name:<13} {b:>5} spp  {seconds:8.2} s  relMSE {relmse:.5}{c}");
             rungs.push(Rung {
                 budget: format!("{b} spp"),
                 seconds,
@@ -174,24 +206,24 @@ pub fn accuracy(
         Some(&reference),
         &cache,
     )?;
-    println!("sppm             64 passes {seconds:8.2} s  relMSE {relmse:.5} (whole run)");
+    let c = corrected(halves, &out.join("image.exr"))?;
+    println!("sppm             64 passes {seconds:8.2} s  relMSE {relmse:.5}{c} (whole run)");
     // Snapshot times count from the first pass; the run's loading and writing come on top.
     let snaps = snapshots(&out)?;
     let overhead = snaps
         .last()
         .map_or(0.0, |&(_, s, _)| (seconds - s).max(0.0));
-    let rungs: Vec<Rung> = snaps
-        .into_iter()
-        .map(|(p, s, e)| {
-            let s = s + overhead;
-            println!("sppm          {p:>5} passes {s:8.2} s  relMSE {e:.5} (snapshot)");
-            Rung {
-                budget: format!("{p} passes"),
-                seconds: s,
-                relmse: e,
-            }
-        })
-        .collect();
+    let mut rungs = Vec::new();
+    for (p, s, e) in snaps {
+        let s = s + overhead;
+        let c = corrected(halves, &out.join(format!("snapshots/pass-{p:05}.exr")))?;
+        println!("sppm          {p:>5} passes {s:8.2} s  relMSE {e:.5}{c} (snapshot)");
+        rungs.push(Rung {
+            budget: format!("{p} passes"),
+            seconds: s,
+            relmse: e,
+        });
+    }
     table.push(("sppm".into(), rungs));
     // Peers run from anywhere: give them an absolute path.
     let abs = std::fs::canonicalize(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
@@ -214,8 +246,9 @@ pub fn accuracy(
             ));
         }
         let m = render::output::compare(&exr, &reference, None)?;
+        let c = corrected(halves, &exr)?;
         println!(
-            "{:<13} {seconds:8.2} s  relMSE {:.5} (incl. start-up)",
+            "{:<13} {seconds:8.2} s  relMSE {:.5}{c} (incl. start-up)",
             peer.name, m.relmse
         );
         // The comparison the path tracer is judged by: its time to the peer's error.

@@ -18,6 +18,8 @@ pub struct EvidenceArgs {
     pub scene: PathBuf,
     /// A linear RGB EXR of the same view (else a path-traced one, rendered once and cached).
     pub reference: Option<PathBuf>,
+    /// The given reference's second independent half (other seed, same budget).
+    pub reference_b: Option<PathBuf>,
     pub reference_spp: u32,
     /// Independent runs per method and budget.
     pub seeds: u32,
@@ -183,6 +185,9 @@ pub fn techniques(quick: bool) -> Vec<Technique> {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Errors {
     pub relmse: f64,
+    /// With the reference given as two halves: the relative MSE with the reference's noise
+    /// taken out (`film::metrics_halves`).
+    pub relmse_corrected: Option<f64>,
     pub relmse_pbrt: f64,
     pub rmse: f64,
     pub mean_ratio: f64,
@@ -239,16 +244,20 @@ pub fn render_image(
 /// decomposes its error against `reference` (the reference's layer `t.layer`, for a
 /// technique that compares one layer).
 #[allow(clippy::too_many_arguments)]
-pub fn rung(
+pub fn rung<'a>(
     scene: &dyn Fn(u64) -> Result<Scene, String>,
     t: &Technique,
     amount: u64,
     seeds: u32,
-    reference: &Image,
+    reference: impl Into<Against<'a>>,
     regions: &[(&'static str, Mask)],
     cache: &Path,
     threads: Option<usize>,
 ) -> Result<RungResult, String> {
+    let Against {
+        image: reference,
+        halves,
+    } = reference.into();
     let o = t.budget.apply(&t.overrides, amount);
     let mut images = Vec::new();
     let mut seconds = 0.0;
@@ -273,7 +282,11 @@ pub fn rung(
     }
     let _ = std::fs::remove_dir_all(cache);
     let runs: Vec<&Image> = images.iter().collect();
-    let maps = BiasVariance::new(&runs, reference, true).map_err(|e| e.to_string())?;
+    let maps = match halves {
+        Some(h) => BiasVariance::against_halves(&runs, h, true),
+        None => BiasVariance::new(&runs, reference, true),
+    }
+    .map_err(|e| e.to_string())?;
     let flips = images
         .iter()
         .map(|img| film::flip(img, reference, 1.0).map_err(|e| e.to_string()))
@@ -289,6 +302,10 @@ pub fn rung(
         for (img, flip) in images.iter().zip(&flips) {
             let m = film::metrics(img, reference, Some(mask)).map_err(|e| e.to_string())?;
             e.relmse += m.relmse / k;
+            if let Some(h) = halves {
+                let c = film::metrics_halves(img, h, Some(mask)).map_err(|e| e.to_string())?;
+                *e.relmse_corrected.get_or_insert(0.0) += c.relmse / k;
+            }
             e.relmse_pbrt += m.relmse_pbrt / k;
             e.rmse += m.rmse / k;
             e.mean_ratio += m.mean_a / m.mean_b / k;
@@ -316,6 +333,23 @@ pub fn rung(
     })
 }
 
+/// What a rung's runs are measured against: an image, and the halves it is the mean of when
+/// the reference came as two.
+#[derive(Clone, Copy)]
+pub struct Against<'a> {
+    pub image: &'a Image,
+    pub halves: Option<&'a film::Halves>,
+}
+
+impl<'a> From<&'a Image> for Against<'a> {
+    fn from(image: &'a Image) -> Against<'a> {
+        Against {
+            image,
+            halves: None,
+        }
+    }
+}
+
 /// The reference (`accuracy::reference`: given, or path-traced once and cached in `out`),
 /// read and checked against the scene's size, with its caustic layer when it has one (a
 /// path-traced reference does: `layers/caustic.exr` beside the image).
@@ -323,6 +357,8 @@ pub struct Reference {
     pub path: PathBuf,
     pub image: Image,
     pub caustic: Option<Image>,
+    /// The two halves `image` is the mean of (`--reference-b`).
+    pub halves: Option<film::Halves>,
 }
 
 fn reference(scene: &Scene, a: &EvidenceArgs) -> Result<Reference, String> {
@@ -347,6 +383,22 @@ fn reference(scene: &Scene, a: &EvidenceArgs) -> Result<Reference, String> {
         }
         Ok(img)
     };
+    if let Some(b) = &a.reference_b {
+        let Some(first) = &a.reference else {
+            return Err(format!(
+                "--reference-b {}: the second half needs the first (--reference)",
+                b.display()
+            ));
+        };
+        let mean = a.out.join("reference-halves-mean.exr");
+        let halves = crate::reference::halves(scene, first, b, &mean)?;
+        return Ok(Reference {
+            path: mean,
+            image: halves.mean.clone(),
+            caustic: None,
+            halves: Some(halves),
+        });
+    }
     let image = read(&path)?;
     let layer = path.with_file_name("layers").join("caustic.exr");
     let caustic = if layer.is_file() {
@@ -358,6 +410,7 @@ fn reference(scene: &Scene, a: &EvidenceArgs) -> Result<Reference, String> {
         path,
         image,
         caustic,
+        halves: None,
     })
 }
 
@@ -438,10 +491,16 @@ pub fn run(a: &EvidenceArgs) -> Result<Measured, String> {
     for mut t in techniques(a.quick).into_iter().filter(|t| wanted(t.name)) {
         t.ladder = t.ladder.iter().map(|&n| scale(n)).collect();
         t.ladder.dedup();
-        let (reference, regions) = match t.layer {
-            None => (&reference.image, &regions),
+        let (against, regions) = match t.layer {
+            None => (
+                Against {
+                    image: &reference.image,
+                    halves: reference.halves.as_ref(),
+                },
+                &regions,
+            ),
             Some(_) => match &reference.caustic {
-                Some(c) => (c, &caustic_regions),
+                Some(c) => (Against::from(c), &caustic_regions),
                 None => {
                     ev.skipped.push(format!(
                         "{}: the reference {} has no layers/caustic.exr beside it",
@@ -454,15 +513,18 @@ pub fn run(a: &EvidenceArgs) -> Result<Measured, String> {
         };
         for &amount in &t.ladder {
             let r = rung(
-                &make, &t, amount, a.seeds, reference, regions, &cache, a.threads,
+                &make, &t, amount, a.seeds, against, regions, &cache, a.threads,
             )?;
+            let e = &r.regions[0].errors;
             println!(
-                "{:<64} {:>22} {:8.2} s  relMSE {:.5}  FLIP {:.4}",
+                "{:<64} {:>22} {:8.2} s  relMSE {:.5}{}  FLIP {:.4}",
                 r.technique,
                 format!("{} {}", r.amount, r.budget.name()),
                 r.seconds,
-                r.regions[0].errors.relmse,
-                r.regions[0].errors.flip,
+                e.relmse,
+                e.relmse_corrected
+                    .map_or(String::new(), |c| format!(" (reference noise out: {c:.5})")),
+                e.flip,
             );
             ev.rungs.push(r);
         }

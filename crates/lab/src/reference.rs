@@ -13,6 +13,22 @@ pub struct Reference {
     pub run: Option<PathBuf>,
 }
 
+/// The reference given as two independent halves `a` and `b` (other seeds, one budget), each
+/// checked against `scene`, with their mean written to `mean` (a linear EXR every run
+/// directory's plain errors are measured against).
+pub fn halves(scene: &Scene, a: &Path, b: &Path, mean: &Path) -> Result<film::Halves, String> {
+    let h = film::Halves::new(
+        &render::read_reference(scene, a)?,
+        &render::read_reference(scene, b)?,
+    )
+    .map_err(|e| format!("{} and {}: {e}", a.display(), b.display()))?;
+    if let Some(dir) = mean.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    film::write_exr(mean, &h.mean).map_err(|e| e.to_string())?;
+    Ok(h)
+}
+
 /// `given`, checked against `scene` before anything is written; else `scene` path-traced at
 /// `spp` samples per pixel (caustics included) into `dir/reference-<settings hash>-<spp>spp`,
 /// reused when that directory's `image.json` was written for the same settings hash (scene

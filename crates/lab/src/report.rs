@@ -925,7 +925,8 @@ fn write_tables(out: &Path, ev: &Evidence) -> Result<(), String> {
                 "technique": r.technique, "sweep": sweep.map(|s| s.variant.clone()),
                 "k": sweep.map(|s| s.k), "budget": r.budget.name(), "amount": r.amount,
                 "seconds": r.seconds, "region": x.region, "pixels": x.sums.pixels,
-                "relmse": e.relmse, "relmse_pbrt": e.relmse_pbrt, "rmse": e.rmse,
+                "relmse": e.relmse, "relmse_corrected": e.relmse_corrected,
+                "relmse_pbrt": e.relmse_pbrt, "rmse": e.rmse,
                 "mean_ratio": e.mean_ratio, "flip": e.flip, "bias2": x.sums.bias2,
                 "variance": x.sums.variance, "mse": x.sums.mse,
             }));

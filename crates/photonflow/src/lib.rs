@@ -83,6 +83,10 @@ enum Cmd {
         /// rendered once into --dir and reused).
         #[arg(long)]
         reference: Option<PathBuf>,
+        /// The reference's second independent half (same budget, another seed): errors
+        /// against the halves' mean, each also with the reference's noise taken out.
+        #[arg(long)]
+        reference_b: Option<PathBuf>,
         /// Samples per pixel of the rendered reference.
         #[arg(long, default_value_t = 4096)]
         reference_spp: u32,
@@ -166,6 +170,10 @@ enum Cmd {
         /// rendered once into --out and reused).
         #[arg(long)]
         reference: Option<PathBuf>,
+        /// The reference's second independent half: errors and bias² against the halves'
+        /// mean, with the reference's noise taken out beside the plain figures.
+        #[arg(long)]
+        reference_b: Option<PathBuf>,
         #[arg(long, default_value_t = 1024)]
         reference_spp: u32,
         /// Independent runs (seeds 1..=N) per technique and budget.
@@ -630,6 +638,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
         Cmd::BenchAccuracy {
             scene,
             reference,
+            reference_b,
             reference_spp,
             peer,
             dir,
@@ -638,11 +647,19 @@ fn run(cmd: Cmd) -> Result<(), String> {
                 .into_iter()
                 .map(|(name, command)| lab::accuracy::Peer { name, command })
                 .collect();
-            lab::accuracy::accuracy(&scene, reference.as_deref(), reference_spp, &peers, &dir)
+            lab::accuracy::accuracy(
+                &scene,
+                reference.as_deref(),
+                reference_b.as_deref(),
+                reference_spp,
+                &peers,
+                &dir,
+            )
         }
         Cmd::Evidence {
             scene,
             reference,
+            reference_b,
             reference_spp,
             seeds,
             quick,
@@ -653,6 +670,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
         } => lab::evidence(&lab::evidence::EvidenceArgs {
             scene,
             reference,
+            reference_b,
             reference_spp,
             seeds,
             quick,
