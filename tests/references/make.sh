@@ -1,0 +1,145 @@
+#!/usr/bin/env bash
+# Mitsuba 3 reference images for photonflow's tests: every scene rendered twice, halves `a` and
+# `b` with independent seeds, as linear RGB float32 EXR (ZIP). README.md says what each file is.
+#
+#   PEERS=/path/to/peers PEERS_VENV=/path/to/venv tests/references/make.sh [NAME...]
+#   PEERS=/path/to/peers PEERS_VENV=/path/to/venv tests/references/make.sh stats
+#
+# PEERS       the peers directory: mitsuba_render.py, objmtl.py, exrio.py, worksheet/
+# PEERS_VENV  the virtual environment the peers' setup.sh made (Mitsuba 3.9.1, drjit 1.5.0,
+#             OpenEXR, numpy); or PEERS_PYTHON=its python
+# VARIANT     Mitsuba variant, default llvm_ad_rgb (needs libLLVM >= 16); scalar_rgb is slower
+#             and draws different random numbers, so its images differ within noise
+# NAME        cornell-spheres-analytic, furnace, plane-light, corner (default: all)
+# `stats` prints the noise figures of the halves present (the tables of README.md).
+#
+# The scenes are read from scenes/*.toml of this repository (camera, and checks that the
+# Mitsuba description still matches), except the worksheet scene's geometry: its box OBJ keeps
+# the emission in Ka, which the peers' OBJ reader does not read, so the peers' copy
+# (worksheet/cornell_worksheet_box.obj, Ke, already in scene units, same triangles) is used.
+set -euo pipefail
+HERE=$(cd "$(dirname "$0")" && pwd)
+REPO=$(cd "$HERE/../.." && pwd)
+: "${PEERS:?set PEERS=/path/to/peers (the directory with mitsuba_render.py)}"
+if [ -z "${PEERS_PYTHON:-}" ]; then
+  : "${PEERS_VENV:?set PEERS_VENV=/path/to/venv (or PEERS_PYTHON=/path/to/python)}"
+  PEERS_PYTHON=$PEERS_VENV/bin/python
+fi
+PY=$PEERS_PYTHON
+VARIANT=${VARIANT:-llvm_ad_rgb}
+SEED_A=1
+SEED_B=2
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+
+# Camera JSON (mitsuba_render.py's format) from a scene file's [camera], at W x H, after
+# checking the scene is still what the Mitsuba description assumes (KIND: obj | worksheet).
+camera() { # KIND SCENE.toml W H OUT.json
+  "$PY" - "$PEERS" "$@" <<'EOF'
+import json, sys, tomllib
+peers, kind, src, w, h, out = sys.argv[1:]
+with open(src, "rb") as f:
+    s = tomllib.load(f)
+def need(ok, what):
+    if not ok:
+        sys.exit(f"{src}: {what}: the Mitsuba description in make.sh no longer matches")
+meshes, spheres, mats = s.get("mesh", []), s.get("sphere", []), s.get("material", {})
+if kind == "obj":  # one OBJ, untransformed, MTL materials with emission in Ke
+    need(len(meshes) == 1 and not spheres and not mats, "one mesh, no spheres, no [material]")
+    m = meshes[0]
+    need(m.get("scale", 1.0) in (1, 1.0, [1, 1, 1]) and m.get("rotate", [0, 0, 0]) == [0, 0, 0]
+         and m.get("translate", [0, 0, 0]) == [0, 0, 0], "no transform")
+    need(m.get("emission", "ke") == "ke" and m.get("normals", "auto") == "auto", "Ke emission, file normals")
+else:  # worksheet: CornellBox.obj scaled 0.025, turned 180 degrees about y, two spheres
+    need(len(meshes) == 1 and meshes[0]["obj"] == "CornellBox.obj" and meshes[0].get("scale") == 0.025
+         and meshes[0].get("rotate") == [0.0, 180.0, 0.0] and meshes[0].get("emission") == "ka", "box mesh")
+    with open(f"{peers}/worksheet/cornell_worksheet_spheres.json") as f:
+        ref = {x["material"]: x for x in json.load(f)["spheres"]}
+    need(len(spheres) == 2, "two spheres")
+    for sp in spheres:
+        r = ref[sp["material"]]
+        need(abs(sp["radius"] - r["radius"]) < 1e-6
+             and max(abs(a - b) for a, b in zip(sp["center"], r["center"])) < 1e-5, "sphere " + sp["material"])
+    need(mats.get("silver") == {"type": "metal", "reflectance": [0.96, 0.98, 0.96]}, "silver: constant-Ks metal")
+    need(mats.get("glass") == {"type": "dielectric", "ior": 1.5}, "glass: dielectric, ior 1.5")
+c = s["camera"]
+cam = {"type": "perspective", "position": c["eye"], "look_at": c["look_at"],
+       "up": c.get("up", [0.0, 1.0, 0.0]), "vfov_deg": c["vfov"], "width": int(w), "height": int(h),
+       "pixel_filter": "box", "near_clip": 1e-3}
+with open(out, "w") as f:
+    json.dump(cam, f)
+EOF
+}
+
+# Two halves of one scene. render NAME KIND SCENE.toml W H SPP SPP_PER_PASS OBJ [ARGS...]
+render() {
+  local name=$1 kind=$2 toml=$3 w=$4 h=$5 spp=$6 pp=$7 obj=$8
+  shift 8
+  camera "$kind" "$toml" "$w" "$h" "$TMP/$name-${w}x$h.json"
+  local half seed
+  for half in a b; do
+    if [ $half = a ]; then seed=$SEED_A; else seed=$SEED_B; fi
+    echo "== $name ${w}x$h half $half: seed $seed, $spp spp"
+    "$PY" "$PEERS/mitsuba_render.py" "$obj" "$@" --camera "$TMP/$name-${w}x$h.json" \
+      --width "$w" --height "$h" --spp "$spp" --spp-per-pass "$pp" --seed "$seed" \
+      --integrator path --max-depth -1 --rr-depth 5 --sampler independent --rfilter box \
+      --variant "$VARIANT" -o "$HERE/$name-${w}x$h-$half.exr"
+  done
+}
+
+stats() {
+  "$PY" - "$PEERS" "$HERE" <<'EOF'
+import glob, os, sys
+import numpy as np
+sys.path.insert(0, sys.argv[1])
+import exrio
+lum = lambda x: 0.2126 * x[..., 0] + 0.7152 * x[..., 1] + 0.0722 * x[..., 2]
+print("| file | mean lum a | mean lum b | (a-b)/mean | z = (a-b)/SE(a-b) | whole-image rel SE, half / both "
+      "| 16x16 region-mean rel SE of a half: median / p90 / max | per-pixel rel SE of a half, median over regions |")
+print("|---|---|---|---|---|---|---|---|")
+for fa in sorted(glob.glob(os.path.join(sys.argv[2], "*-a.exr"))):
+    fb = fa[:-6] + "-b.exr"
+    if not os.path.exists(fb):
+        continue
+    A, B = (lum(exrio.read_exr(f).astype(np.float64)) for f in (fa, fb))
+    M, D = (A + B) / 2, (A - B) / 2      # E[D^2] = var(M) = var(half) / 2 per pixel
+    n = M.size
+    var_half = 2 * D * D                   # one-sample estimate of a half's per-pixel variance
+    se_half = np.sqrt(var_half.sum()) / n  # SE of a half's whole-image mean
+    m = M.mean()
+    z = (A.mean() - B.mean()) / (np.sqrt(2) * se_half)
+    H, W = M.shape
+    r = 16 if H >= 32 else H // 2
+    vr = var_half.reshape(H // r, r, W // r, r).sum(axis=(1, 3)) / (r * r) ** 2
+    mr = M.reshape(H // r, r, W // r, r).mean(axis=(1, 3))
+    lit = mr > 1e-3 * m
+    rel_r = np.sqrt(vr[lit]) / mr[lit]
+    pix = np.sqrt(var_half.reshape(H // r, r, W // r, r).mean(axis=(1, 3))[lit]) / mr[lit]
+    reg = f"{r}x{r}" if r != 16 else ""
+    print(f"| {os.path.basename(fa)[:-6]} | {A.mean():.6f} | {B.mean():.6f} | {(A.mean() - B.mean()) / m:+.5%} | {z:+.2f} "
+          f"| {se_half / m:.4%} / {se_half / np.sqrt(2) / m:.4%} "
+          f"| {np.median(rel_r):.3%} / {np.percentile(rel_r, 90):.3%} / {rel_r.max():.3%}{' (' + reg + ')' if reg else ''} "
+          f"| {np.median(pix):.2%} |")
+EOF
+}
+
+P=$PEERS/worksheet
+S=$REPO/scenes
+names=("$@")
+[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic furnace plane-light corner)
+for n in "${names[@]}"; do
+  case $n in
+    cornell-spheres-analytic)
+      render $n worksheet "$S/cornell-spheres/analytic.toml" 128 128 8192 1024 \
+        "$P/cornell_worksheet_box.obj" --spheres "$P/cornell_worksheet_spheres.json" ;;
+    furnace)
+      render $n obj "$S/furnace/furnace.toml" 16 16 16384 16384 "$S/furnace/box.obj"
+      render $n obj "$S/furnace/furnace.toml" 32 32 16384 4096 "$S/furnace/box.obj" ;;
+    plane-light)
+      render $n obj "$S/plane-light/plane-light.toml" 64 64 16384 1024 "$S/plane-light/plane.obj" ;;
+    corner)
+      render $n obj "$S/corner/corner.toml" 64 64 16384 1024 "$S/corner/corner.obj" ;;
+    stats) stats ;;
+    *) echo "unknown NAME $n" >&2; exit 2 ;;
+  esac
+done
