@@ -15,6 +15,8 @@
 //!   degenerate triangles, a sphere of radius 1e-4 (also seen up close), light power near the
 //!   f32 limit): every image finite, closed forms, flux and invariances where the scene
 //!   allows a check.
+//! - `references`: photonflow's images against Mitsuba 3's (`tests/references/`, two halves),
+//!   region by region, with negative controls that must fail.
 //! - `photons`: photon flux against the path tracer (caustic flux under the glass sphere) and
 //!   against the light power (closed furnace box).
 //! - `photon_maps`: the photon-map methods through the pipeline library, trace to image: the
@@ -45,6 +47,7 @@ mod hard_cases;
 mod kit;
 mod photon_maps;
 mod photons;
+mod references;
 mod shards;
 mod splat;
 mod sppm;
