@@ -125,7 +125,10 @@ fn path_image(scene: &Scene, spp: u32) -> Image {
 }
 
 /// The edits of the negative controls: each must move some region out of its tolerance.
-fn controls() -> Vec<(&'static str, Box<dyn Fn(&mut SceneFile)>)> {
+/// A named edit of the scene file.
+type Control = (&'static str, Box<dyn Fn(&mut SceneFile)>);
+
+fn controls() -> Vec<Control> {
     let lambertian =
         |albedo: [f32; 3], emission: [f32; 3]| MaterialDesc::Lambertian { albedo, emission };
     vec![
@@ -196,8 +199,7 @@ fn the_reference_comparison_catches_a_two_percent_change() {
     let regs = regions(&scene(1, |_| {}));
     let check = |s: &Scene| {
         let img = path_image(s, 64);
-        let bad = misfits(&img, &regs, &|r| path_rel_se(64, r), &|_| 0.0);
-        bad
+        misfits(&img, &regs, &|r| path_rel_se(64, r), &|_| 0.0)
     };
     let clean = check(&scene(2, |_| {}));
     assert!(clean.is_empty(), "unchanged scene: {clean:#?}");

@@ -227,14 +227,46 @@ fn render_writes_exr_png_layers_and_json_identically_for_any_thread_count() {
     ] {
         assert!(json.contains(key), "{key} missing from {json}");
     }
-    // An image compared with itself has zero error.
-    let exr = out1.join("image.exr");
-    let o = photonflow(&["compare", exr.to_str().unwrap(), exr.to_str().unwrap()]);
+}
+
+/// `compare TEST A B`: against the halves' mean, with the reference's noise taken out, on
+/// images whose errors are known exactly: the halves are 1 ± 0.05 pixel by pixel (their mean
+/// is exactly 1, its variance estimate (A - B)²/4 = 0.0025 everywhere) and the test image is
+/// 1.1, so the plain MSE is 0.01 and the corrected one 0.0075.
+#[test]
+fn compare_takes_a_references_noise_out_given_its_two_halves() {
+    let dir = Scratch::new("halves", &[]);
+    let write = |name: &str, f: &dyn Fn(usize, usize) -> f32| {
+        let p = dir.0.join(name);
+        film::write_exr(&p, &film::Image::from_fn(8, 8, |x, y| [f(x, y); 3])).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let sign = |x: usize, y: usize| if (x + y) % 2 == 0 { 1.0 } else { -1.0 };
+    let a = write("a.exr", &|x, y| 1.0 + 0.05 * sign(x, y));
+    let b = write("b.exr", &|x, y| 1.0 - 0.05 * sign(x, y));
+    let t = write("t.exr", &|_, _| 1.1);
+    let o = photonflow(&["compare", &t, &a, &b]);
     let text = String::from_utf8_lossy(&o.stdout);
-    assert!(
-        o.status.success() && text.contains("rmse=0.000000e0 "),
-        "{text}"
-    );
+    assert!(o.status.success(), "{text}");
+    let value = |after: &str, key: &str| -> f64 {
+        let start = text.find(after).unwrap_or_else(|| panic!("{text}")) + after.len();
+        let part = &text[start..];
+        let v = part.split(key).nth(1).unwrap_or_else(|| panic!("{text}"));
+        v.split_whitespace().next().unwrap().parse().unwrap()
+    };
+    // Plain: rmse 0.1 (f32 images: 1.1 and 1 ± 0.05 are not exact, hence the tolerances).
+    assert!((value("", "rmse=") - 0.1).abs() < 1e-6, "{text}");
+    // relmse = (mse - var) / (1 + 0.01) per element.
+    let corrected = value("taken out:", "relmse=");
+    assert!((corrected - 0.0075 / 1.01).abs() < 1e-6, "{text}");
+    assert!((value("taken out:", " rmse=") - 0.0075f64.sqrt()).abs() < 1e-6, "{text}");
+    // Halves of different sizes are refused, naming them.
+    let small = dir.0.join("s.exr");
+    film::write_exr(&small, &film::Image::from_fn(4, 4, |_, _| [1.0; 3])).unwrap();
+    let o = photonflow(&["compare", &t, &a, small.to_str().unwrap()]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains("s.exr") && e.contains("size"), "{e}");
 }
 
 #[test]
