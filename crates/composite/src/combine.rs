@@ -364,6 +364,14 @@ pub fn composite(inputs: Vec<Input>) -> Result<Composite, String> {
                 ]
             })
             .collect();
+        // The result is itself an input to later composites, whose counts are bounded too.
+        if total > crate::meta::MAX_COUNT {
+            return Err(format!(
+                "composite: layer '{}': the counts sum to {total}, beyond 2^53 (the largest \
+                 count an image.json may hold)",
+                g.name
+            ));
+        }
         if !total.is_finite() || data.iter().flatten().any(|v| !v.is_finite()) {
             return Err(format!(
                 "composite: layer '{}': the count-weighted sum overflows",

@@ -43,7 +43,8 @@ impl fmt::Display for CountKind {
 pub struct LayerMeta {
     pub name: String,
     pub classes: Vec<Class>,
-    /// Positive and finite. Integral for single runs; a composite's count is a sum of them.
+    /// Positive, at most [`MAX_COUNT`]. Integral for single runs; a composite's count is a sum
+    /// of them.
     pub count: f64,
     pub count_kind: CountKind,
 }
@@ -82,11 +83,28 @@ fn count_of(v: &Value, what: &str) -> Result<f64, String> {
     Ok(c)
 }
 
+/// Largest count: 2^53, the largest integer up to which an f64 holds every integer. Counts
+/// are samples or photon paths, integers, and no run makes 2^53 of them; a count of 1e300
+/// would weigh every other run of its layer down to nothing.
+pub const MAX_COUNT: f64 = 9_007_199_254_740_992.0;
+
 fn check_count(c: f64) -> Result<(), String> {
-    if c.is_finite() && c > 0.0 {
-        Ok(())
+    // 1e300 as written, not as its 301 digits.
+    let shown = if c.abs() >= 1e16 {
+        format!("{c:e}")
     } else {
-        Err(format!("{c} must be positive and finite"))
+        format!("{c}")
+    };
+    if !(c.is_finite() && c > 0.0) {
+        Err(format!("{shown} must be positive and finite"))
+    } else if c > MAX_COUNT {
+        Err(format!(
+            "{shown} exceeds 2^53 = {}: counts are samples or photon paths, integers an f64 \
+             holds exactly",
+            MAX_COUNT as u64
+        ))
+    } else {
+        Ok(())
     }
 }
 
@@ -122,7 +140,7 @@ fn dim_of(obj: &Map<String, Value>, key: &str) -> Result<usize, String> {
 
 /// A count as JSON: an integer when it is one (exactly representable), else a float.
 fn count_json(c: f64) -> Value {
-    if c.fract() == 0.0 && (0.0..=9_007_199_254_740_992.0).contains(&c) {
+    if c.fract() == 0.0 && (0.0..=MAX_COUNT).contains(&c) {
         json!(c as u64)
     } else {
         json!(c)
@@ -224,7 +242,7 @@ impl Meta {
     /// Checks what [`Meta::from_json`] cannot express by types: a non-empty `view_hash`, a
     /// non-empty size, at least one layer, layer names usable as file names
     /// (`[A-Za-z0-9_-]+`) and unique, every layer estimating at least one class and no class
-    /// twice, counts positive and finite, and no class estimated by two layers.
+    /// twice, counts positive and at most [`MAX_COUNT`], and no class estimated by two layers.
     pub fn validate(&self) -> Result<(), String> {
         if self.view_hash.is_empty() {
             return Err("view_hash is empty".into());

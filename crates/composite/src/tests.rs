@@ -453,6 +453,10 @@ fn refusals_name_the_input_and_the_problem() {
             bad(&|i| i.meta.layers[0].count = f64::NAN),
         ),
         (
+            "count 1e300 exceeds 2^53",
+            bad(&|i| i.meta.layers[0].count = 1e300),
+        ),
+        (
             "cannot weigh them together",
             bad(&|i| i.meta.layers[0].count_kind = CountKind::PhotonPaths),
         ),
@@ -519,6 +523,14 @@ fn refusals_name_the_input_and_the_problem() {
     for (problem, input) in cases {
         refused(vec![good(), input], "bad/run", problem);
     }
+    // Each count within bounds, their sum not: the composite's own image.json could not be
+    // read back (2^53 + 2^53 = 2^54).
+    let big = |label: &str, v: f32| direct(label, 9_007_199_254_740_992.0, [v; 3]);
+    let e = composite(vec![big("a/run", 1.0), big("b/run", 2.0)]).unwrap_err();
+    assert!(
+        e.contains("layer 'direct': the counts sum to 18014398509481984, beyond 2^53"),
+        "{e}"
+    );
 }
 
 const EXAMPLE: &str = r#"{ "view_hash": "0123456789abcdef",
@@ -593,6 +605,15 @@ fn meta_refuses_bad_image_json() {
             "count \"64\" is not a number",
         ),
         (with(r#""count": 64"#, r#""count": 1e999"#), "invalid JSON"),
+        // Finite, but it would weigh every other run of its layers down to 1e-300.
+        (
+            with(r#""count": 64"#, r#""count": 1e300"#),
+            "count 1e300 exceeds 2^53 = 9007199254740992",
+        ),
+        (
+            with(r#""count": 64"#, r#""count": 9007199254740993.0"#),
+            "exceeds 2^53",
+        ),
         (
             with(r#""count": 64, "count_kind": "spp","#, ""),
             "count and count_kind are missing",

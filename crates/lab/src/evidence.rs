@@ -151,14 +151,16 @@ pub fn techniques(quick: bool) -> Vec<Technique> {
             ladder: ladder(&[4, 16], &[4, 16, 64]),
         },
         // The caustic map as the course's final gathering makes it (k = 250, every path of
-        // the trace paid for, the global set's included, and direct light; no gather rays),
-        // against
-        // photon-differential splatting onto eye vertices (no map, no global set).
+        // the trace paid for, the global set's included, and direct light; one gather ray
+        // straight into the global map, no irradiance cache: the least indirect light final
+        // gathering computes), against photon-differential splatting onto eye vertices (no
+        // map, no global set).
         Technique {
             name: "caustic map (k-NN)",
             overrides: Overrides {
                 method: Some(Method::FinalGather),
-                gather_rays: Some(0),
+                gather_rays: Some(1),
+                gather_cache: Some(0),
                 ..Overrides::default()
             },
             budget: Budget::Photons,

@@ -241,7 +241,7 @@ fn compare_takes_a_references_noise_out_given_its_two_halves() {
         film::write_exr(&p, &film::Image::from_fn(8, 8, |x, y| [f(x, y); 3])).unwrap();
         p.to_str().unwrap().to_string()
     };
-    let sign = |x: usize, y: usize| if (x + y) % 2 == 0 { 1.0 } else { -1.0 };
+    let sign = |x: usize, y: usize| if (x + y).is_multiple_of(2) { 1.0 } else { -1.0 };
     let a = write("a.exr", &|x, y| 1.0 + 0.05 * sign(x, y));
     let b = write("b.exr", &|x, y| 1.0 - 0.05 * sign(x, y));
     let t = write("t.exr", &|_, _| 1.1);
@@ -259,7 +259,10 @@ fn compare_takes_a_references_noise_out_given_its_two_halves() {
     // relmse = (mse - var) / (1 + 0.01) per element.
     let corrected = value("taken out:", "relmse=");
     assert!((corrected - 0.0075 / 1.01).abs() < 1e-6, "{text}");
-    assert!((value("taken out:", " rmse=") - 0.0075f64.sqrt()).abs() < 1e-6, "{text}");
+    assert!(
+        (value("taken out:", " rmse=") - 0.0075f64.sqrt()).abs() < 1e-6,
+        "{text}"
+    );
     // Halves of different sizes are refused, naming them.
     let small = dir.0.join("s.exr");
     film::write_exr(&small, &film::Image::from_fn(4, 4, |_, _| [1.0; 3])).unwrap();

@@ -125,6 +125,15 @@ pub fn trace(
     threads: usize,
 ) -> Result<Manifest, String> {
     let threads = threads.max(1);
+    // Shards are ranges of photon paths: with more shards than paths some cover nothing,
+    // and publishing those as finished work hides a mistyped N.
+    if u64::from(shard.count) > params.photons {
+        return Err(format!(
+            "--shard {shard}: {} shards of a run of {} photon paths would leave shards with no \
+             path; N must be at most {}",
+            shard.count, params.photons, params.photons
+        ));
+    }
     let plan = emit::Plan::for_scene(scene, params)
         .map_err(|e| format!("{}: {e}", scene.path.display()))?;
     let key = CacheKey::new(scene, params);
@@ -223,7 +232,39 @@ pub fn read_input(p: &Path) -> Result<Input, String> {
             m.total
         ));
     }
+    check_count(&m).map_err(|e| format!("{}: {e}", path.display()))?;
     Ok(Input { dir, m, shard })
+}
+
+/// A manifest's `count` is what its range holds (photon paths, or the samples or passes of
+/// its blocks): a merge weighs the shard by it, so a forged count would weigh it wrongly.
+fn check_count(m: &Manifest) -> Result<(), String> {
+    let [a, b] = m.range;
+    let (holds, what) = match m.what.as_str() {
+        "photons" => (b - a, format!("its range {a}..{b} holds")),
+        "image" => {
+            if m.total != m.blocks.len() as u64 {
+                return Err(format!(
+                    "total {} blocks, but it lists {}",
+                    m.total,
+                    m.blocks.len()
+                ));
+            }
+            // In range: a <= b <= total, checked by the caller.
+            let mine = m.blocks.get(a as usize..b as usize).unwrap_or_default();
+            let n = mine
+                .iter()
+                .map(|r| r[1].saturating_sub(r[0]))
+                .fold(0u64, u64::saturating_add);
+            (n, format!("its blocks {a}..{b} hold"))
+        }
+        // `merge` refuses what it does not know, naming it.
+        _ => return Ok(()),
+    };
+    if m.count != holds {
+        return Err(format!("count {}, but {what} {holds} {}", m.count, m.unit));
+    }
+    Ok(())
 }
 
 /// The shard directories `inputs`, each read and checked, and checked to be parts of one run
@@ -274,11 +315,30 @@ pub fn read_all(inputs: &[PathBuf], out: &Path) -> Result<(Vec<Input>, Vec<Part>
             ));
         }
     }
-    if out.exists() && all.iter().any(|i| same_dir(&i.dir, out)) {
-        return Err(format!(
-            "{}: the output directory is an input; choose another --out",
-            out.display()
-        ));
+    // Writing into a shard (or over a directory holding one) would change an input of this
+    // very merge, or of the next one.
+    if let Some(o) = resolve(out) {
+        for i in &all {
+            let Some(d) = resolve(&i.dir) else { continue };
+            let problem = if o == d {
+                "is an input"
+            } else if o.starts_with(&d) {
+                "lies inside the input shard"
+            } else if d.starts_with(&o) {
+                "contains the input shard"
+            } else {
+                continue;
+            };
+            let shard = if o == d {
+                String::new()
+            } else {
+                format!(" {}", i.dir.display())
+            };
+            return Err(format!(
+                "{}: the output directory {problem}{shard}; choose another --out",
+                out.display()
+            ));
+        }
     }
     let parts: Vec<Part> = all
         .iter()
@@ -296,6 +356,31 @@ pub fn merge_photons(all: &[Input], parts: &[Part], out: &Path) -> Result<String
     let total = all.first().map_or(0, |a| a.m.total);
     let order = cover(parts, total, &|s| s.range(total))?;
     merge_photon_files(all, &order, out)
+}
+
+/// `p` made absolute with its symbolic links and `..` resolved, also when it does not exist
+/// yet (an output directory): its deepest existing ancestor canonicalised, the rest appended.
+/// `None` if not even that resolves.
+fn resolve(p: &Path) -> Option<PathBuf> {
+    use std::path::Component;
+    let abs = std::path::absolute(p).ok()?;
+    let parts: Vec<Component> = abs.components().collect();
+    // The longest prefix that exists (the root always does).
+    let (k, mut real) = (0..=parts.len()).rev().find_map(|k| {
+        let prefix: PathBuf = parts.get(..k)?.iter().collect();
+        std::fs::canonicalize(prefix).ok().map(|r| (k, r))
+    })?;
+    // What is left does not exist: a `..` in it climbs lexically.
+    for c in parts.get(k..)? {
+        match c {
+            Component::ParentDir => {
+                real.pop();
+            }
+            Component::Normal(n) => real.push(n),
+            _ => {}
+        }
+    }
+    Some(real)
 }
 
 pub fn same_dir(a: &Path, b: &Path) -> bool {
@@ -344,11 +429,11 @@ fn merge_photon_files(all: &[Input], order: &[usize], out: &Path) -> Result<Stri
                 ))
             } else if h.scene_hash != scene_hash || h.params_hash != params_hash {
                 Some("was traced for another scene or parameters than its shard.json says".into())
-            } else if h.emitted != inp.m.count || inp.m.count != inp.m.range[1] - inp.m.range[0] {
+            } else if h.emitted != inp.m.count {
+                // `read_input` held the manifest's count against its range already.
                 Some(format!(
-                    "counts {} emitted paths, its shard covers {}",
-                    h.emitted,
-                    inp.m.range[1] - inp.m.range[0]
+                    "counts {} emitted paths, but its shard.json's count is {}",
+                    h.emitted, inp.m.count
                 ))
             } else {
                 None

@@ -65,6 +65,11 @@ pub struct RenderSummary {
 pub fn render(scene: &Scene, req: &RenderRequest) -> Result<RenderSummary, String> {
     let t0 = std::time::Instant::now();
     let settings = Settings::new(scene, &req.overrides)?;
+    settings.check_pass_photons(
+        scene,
+        &req.overrides,
+        &methods::row(settings.method).flags(),
+    )?;
     let run = Run {
         scene,
         settings: &settings,

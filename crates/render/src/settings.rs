@@ -213,6 +213,17 @@ impl Knob {
         }
     }
 
+    /// The problem with `v` as this setting's value, if any (the caller names the file's key
+    /// or the flag): the same bounds for both.
+    pub fn check(self, v: u32) -> Result<(), String> {
+        match self {
+            Knob::RenderSpp => count_in(v.into(), 1 << 24, "16777216"),
+            Knob::EstimateSpp | Knob::SplatPasses | Knob::SppmPasses => {
+                count_in(v.into(), 1 << 20, "1048576")
+            }
+        }
+    }
+
     pub fn get(self, s: &Settings) -> u32 {
         match self {
             Knob::RenderSpp => s.render.spp,
@@ -261,10 +272,12 @@ impl Settings {
         let mut render = file.render.clone();
         let method = o.method.unwrap_or(render.method);
         render.method = method;
+        let flags = flags(method);
+        // A flag's value is refused as the flag's, before the file is blamed for anything.
+        o.check()?;
         if let Some(n) = o.photons {
             emit.photons = n;
         }
-        let flags = flags(method);
         if o.caustics.is_some() && !flags.path_tracer {
             return Err(format!(
                 "--no-caustics applies to the path tracer; {method} takes caustics from photons"
@@ -324,7 +337,10 @@ impl Settings {
             ("--passes", o.passes, flags.passes),
         ] {
             match (value, knob) {
-                (Some(v), Some(k)) => k.set(&mut s, v),
+                (Some(v), Some(k)) => {
+                    k.check(v).map_err(|p| format!("{flag} {v}: {p}"))?;
+                    k.set(&mut s, v);
+                }
                 (Some(_), None) => {
                     return Err(format!(
                         "{flag}: {method} takes no {flag} (see `photonflow render --help`)"
@@ -333,7 +349,7 @@ impl Settings {
                 (None, _) => {}
             }
         }
-        s.validate().map_err(err)?;
+        s.validate(scene).map_err(err)?;
         Ok(s)
     }
 
@@ -352,34 +368,32 @@ impl Settings {
         scene::fnv1a64(text.as_bytes())
     }
 
-    fn validate(&self) -> Result<(), String> {
+    /// Checks the resolved settings, every key against its bounds whatever the method (the
+    /// flags' values were checked as flags first, so what fails here is the file's). Errors
+    /// name one key each; the caller prefixes the scene file.
+    fn validate(&self, scene: &Scene) -> Result<(), String> {
         let e = &self.estimate;
-        if self.emit.photons == 0 || self.emit.photons > 1 << 40 {
-            return Err(format!(
-                "photons = {} must be in 1..=2^40",
-                self.emit.photons
-            ));
-        }
-        if self.render.spp == 0 || self.render.spp > 1 << 24 {
-            return Err(format!(
-                "render.spp = {} must be in 1..=16777216",
-                self.render.spp
-            ));
-        }
-        if e.spp == 0 || e.spp > 1 << 20 {
-            return Err(format!("estimate.spp = {} must be in 1..=1048576", e.spp));
+        let key = |k: &str, v: &dyn std::fmt::Display, r: Result<(), String>| {
+            r.map_err(|p| format!("{k} = {v} {p}"))
+        };
+        key(
+            "photons",
+            &self.emit.photons,
+            check_photons(self.emit.photons),
+        )?;
+        for k in [
+            Knob::RenderSpp,
+            Knob::EstimateSpp,
+            Knob::SplatPasses,
+            Knob::SppmPasses,
+        ] {
+            let v = k.get(self);
+            key(k.key(), &v, k.check(v))?;
         }
         for (name, p) in [("global", &e.global), ("caustic", &e.caustic)] {
-            if p.k == 0 || p.k > 1 << 20 {
-                return Err(format!(
-                    "estimate.{name}.k = {} must be in 1..=1048576",
-                    p.k
-                ));
-            }
-            if let Some(eps) = p.topo
-                && !(eps > 0.0 && eps <= 1.0)
-            {
-                return Err(format!("estimate.{name}.topo = {eps} must be in (0, 1]"));
+            key(&format!("estimate.{name}.k"), &p.k, check_k(p.k))?;
+            if let Some(eps) = p.topo {
+                key(&format!("estimate.{name}.topo"), &eps, check_topo(eps))?;
             }
             if p.r_max.is_nan() || p.r_max <= 0.0 {
                 return Err(format!(
@@ -388,12 +402,8 @@ impl Settings {
                 ));
             }
         }
-        if e.final_gather.rays > 1 << 16 {
-            return Err(format!(
-                "estimate.final_gather.rays = {} is absurd (at most 65536)",
-                e.final_gather.rays
-            ));
-        }
+        let rays = e.final_gather.rays;
+        key("estimate.final_gather.rays", &rays, check_gather_rays(rays))?;
         let sp = &e.splat;
         if !(sp.scale > 0.0 && sp.scale <= 1e3) {
             return Err(format!(
@@ -401,43 +411,44 @@ impl Settings {
                 sp.scale
             ));
         }
-        if !(sp.isotropic_radius >= 0.0 && sp.isotropic_radius.is_finite()) {
+        for (name, r) in [
+            ("isotropic_radius", sp.isotropic_radius),
+            ("max_radius", sp.max_radius),
+            // 0 is the automatic radius; a negative or NaN one used to become it silently.
+            ("indirect_radius", sp.indirect_radius),
+        ] {
+            if !(r >= 0.0 && r.is_finite()) {
+                return Err(format!(
+                    "estimate.splat.{name} = {r} must be finite and >= 0 (0: automatic)"
+                ));
+            }
+        }
+        if sp.photons > 1 << 40 {
             return Err(format!(
-                "estimate.splat.isotropic_radius = {} must be finite and >= 0",
-                sp.isotropic_radius
+                "estimate.splat.photons = {} is absurd (at most 2^40)",
+                sp.photons
             ));
         }
-        if !(sp.max_radius >= 0.0 && sp.max_radius.is_finite()) {
+        if sp.splits > 16 {
             return Err(format!(
-                "estimate.splat.max_radius = {} must be finite and >= 0",
-                sp.max_radius
-            ));
-        }
-        if sp.passes == 0 || sp.passes > 1 << 20 {
-            return Err(format!(
-                "estimate.splat.passes = {} must be in 1..=1048576",
-                sp.passes
+                "estimate.splat.splits = {} is absurd (at most 16)",
+                sp.splits
             ));
         }
         let sm = &e.sppm;
-        if sm.passes == 0 || sm.passes > 1 << 20 || sm.photons > 1 << 40 {
+        key(
+            "estimate.sppm.photons",
+            &sm.photons,
+            check_sppm_photons(sm.photons),
+        )?;
+        if !(sm.alpha > 0.0 && sm.alpha < 1.0) {
             return Err(format!(
-                "estimate.sppm: passes = {} must be in 1..=1048576 and photons = {} at most 2^40",
-                sm.passes, sm.photons
+                "estimate.sppm.alpha = {} must be in (0, 1)",
+                sm.alpha
             ));
         }
-        if !(sm.alpha > 0.0 && sm.alpha < 1.0 && sm.radius >= 0.0 && sm.radius.is_finite()) {
-            return Err(format!(
-                "estimate.sppm: alpha = {} must be in (0, 1) and radius = {} finite and >= 0",
-                sm.alpha, sm.radius
-            ));
-        }
-        if sp.photons > 1 << 40 || sp.splits > 16 {
-            return Err(format!(
-                "estimate.splat: photons = {} (at most 2^40) or splits = {} (at most 16) is absurd",
-                sp.photons, sp.splits
-            ));
-        }
+        check_sppm_radius(sm.radius, scene)
+            .map_err(|p| format!("estimate.sppm.radius = {} {p}", sm.radius))?;
         if e.boundary && e.global.topo.is_none() {
             return Err(
                 "boundary correction needs the topological test (estimate.global.topo, or \
@@ -447,6 +458,30 @@ impl Settings {
             );
         }
         Ok(())
+    }
+
+    /// Refuses SPPM passes of more photon paths than one pass can map when they come from
+    /// `[photons] photons` (or `--photons`, named as the flag), as they do with
+    /// `[estimate.sppm] photons` at 0 (that key is bounded in every command). For the commands
+    /// that run SPPM only: `trace` of the same scene writes photon files, which the space on
+    /// disk bounds instead. `flags` are the method's ([`Settings::parse`]).
+    pub fn check_pass_photons(
+        &self,
+        scene: &Scene,
+        o: &Overrides,
+        flags: &Flags,
+    ) -> Result<(), String> {
+        if !traces_per_pass(flags) || self.estimate.sppm.photons > 0 {
+            return Ok(());
+        }
+        let n = self.emit.photons;
+        check_sppm_photons(n).map_err(|p| {
+            let what = format!("is sppm's pass size (estimate.sppm.photons is 0), so it {p}");
+            match o.photons {
+                Some(_) => format!("--photons {n}: {what}"),
+                None => format!("{}: photons = {n}: {what}", scene.path.display()),
+            }
+        })
     }
 
     /// The scene file with these settings written in, mesh paths made absolute: rendering it
@@ -469,6 +504,124 @@ impl Settings {
         }
         Ok(f)
     }
+}
+
+impl Overrides {
+    /// Refuses a flag's value that the scene file's key would be refused for, naming the flag
+    /// ("--k 0: must be in 1..=1048576"), not the file that does not hold it. `--spp` and
+    /// `--passes` are checked where [`Settings::parse`] knows their knob; `--photons` as
+    /// SPPM's paths per pass by [`Settings::check_pass_photons`].
+    fn check(&self) -> Result<(), String> {
+        let flag = |name: &str, v: &dyn std::fmt::Display, r: Result<(), String>| {
+            r.map_err(|p| format!("{name} {v}: {p}"))
+        };
+        if let Some(n) = self.photons {
+            flag("--photons", &n, check_photons(n))?;
+        }
+        if let Some(k) = self.k {
+            flag("--k", &k, check_k(k))?;
+        }
+        if let Some(Some(eps)) = self.topo {
+            flag("--topo", &eps, check_topo(eps))?;
+        }
+        if let Some(r) = self.gather_rays {
+            flag("--gather-rays", &r, check_gather_rays(r))?;
+        }
+        Ok(())
+    }
+}
+
+/// The bounds of one setting: `Err` holds the problem without the key's name, so the scene
+/// file's key ("estimate.global.k = 0 must be ...") and a flag ("--k 0: must be ...") share
+/// the same words.
+fn count_in(v: u64, max: u64, shown: &str) -> Result<(), String> {
+    if v == 0 || v > max {
+        Err(format!("must be in 1..={shown}"))
+    } else {
+        Ok(())
+    }
+}
+
+fn check_photons(n: u64) -> Result<(), String> {
+    count_in(n, 1 << 40, "2^40")
+}
+
+fn check_k(k: usize) -> Result<(), String> {
+    count_in(k as u64, 1 << 20, "1048576")
+}
+
+fn check_topo(eps: f32) -> Result<(), String> {
+    if eps > 0.0 && eps <= 1.0 {
+        Ok(())
+    } else {
+        Err("must be in (0, 1]".into())
+    }
+}
+
+fn check_gather_rays(rays: u32) -> Result<(), String> {
+    match rays {
+        // Without gather rays the `indirect` layer is black yet still claims indirect light,
+        // so a composite would take it for an estimate of it.
+        0 => Err(
+            "must be at least 1: final gathering estimates indirect light by its \
+             gather rays, and none leaves it out of the image"
+                .into(),
+        ),
+        r if r > 1 << 16 => Err("is absurd (at most 65536)".into()),
+        _ => Ok(()),
+    }
+}
+
+/// Most photon paths one SPPM pass may trace. A pass keeps every photon it stores in memory
+/// (32 bytes each) under one kd-tree that indexes with u32 (`MAX_MAP_PHOTONS`), and SPPM stores
+/// about one photon per diffuse bounce: in a closed scene a path makes one or more, so a pass
+/// of more paths than the index holds would hold more photons than it can index, and even at
+/// one photon per four paths 34 GB of them. Bounded in paths, which the settings say, not in
+/// photons, which only tracing would tell. 1e12 paths per pass used to be accepted, and ran
+/// for days towards running out of memory.
+pub const MAX_SPPM_PHOTONS: u64 = crate::maps::MAX_MAP_PHOTONS;
+
+/// `estimate.sppm.photons` (0: `[photons] photons`).
+fn check_sppm_photons(n: u64) -> Result<(), String> {
+    if n > MAX_SPPM_PHOTONS {
+        Err(format!(
+            "must be at most {MAX_SPPM_PHOTONS} photon paths per pass (one pass's photons, \
+             about one per diffuse bounce, go into one in-memory kd-tree that u32 indexes)"
+        ))
+    } else {
+        Ok(())
+    }
+}
+
+/// The method runs SPPM's passes, each of which traces `estimate.sppm.photons` (or
+/// `[photons] photons`) new paths: the method table says so by where `--passes` goes, so
+/// nothing here matches on `Method`.
+fn traces_per_pass(flags: &Flags) -> bool {
+    flags.passes == Some(Knob::SppmPasses)
+}
+
+/// `estimate.sppm.radius` (0: automatic): finite, >= 0, and at most the scene's bounding
+/// diagonal. Visible points and photons all lie inside the scene's bounds, so a disc of the
+/// diagonal's radius already gathers every photon of a pass; a wider one gathers no more and
+/// only divides them over more area (at 1e30 the area itself overflowed f32 and indirect light
+/// vanished). The diagonal is the tightest bound that refuses nothing that could matter.
+fn check_sppm_radius(r: f32, scene: &Scene) -> Result<(), String> {
+    if !(r >= 0.0 && r.is_finite()) {
+        return Err("must be finite and >= 0 (0: automatic)".into());
+    }
+    let b = scene.geometry.bounds();
+    let diagonal = (b.max - b.min).length();
+    if diagonal.is_finite() && r > diagonal {
+        return Err(format!(
+            "exceeds the scene's bounding diagonal ({diagonal}): a disc that wide already \
+             holds every photon, and a wider one only dilutes them (0: automatic)"
+        ));
+    }
+    // Without bounds to compare with, at least pi r^2 must stay finite in f32.
+    if !(std::f32::consts::PI * r * r).is_finite() {
+        return Err("is so large that pi r^2 overflows f32".into());
+    }
+    Ok(())
 }
 
 /// `[estimate]` with the framework's per-map defaults of k filled in where a sub-table leaves

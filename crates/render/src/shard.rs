@@ -14,6 +14,7 @@ use glam::DVec3;
 pub use photons::shard::ShardId;
 use photons::shard::{Input, MANIFEST, Manifest, VERSION, hex, publish, start};
 use scene::Scene;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 /// The f64 block sums of an image shard (`film::write_sums`), block by block, layer by layer.
@@ -42,6 +43,7 @@ pub fn render(run: &Run, shard: ShardId, out: &Path) -> Result<Manifest, String>
     })?;
     let mut b = blocks_fn(run);
     let total = b.blocks.len() as u64;
+    check_split(&b.blocks, b.unit, shard)?;
     let mine = shard.blocks(&b.blocks, b.blocks.last().map_or(0, |r| r.end));
     let layers = b.acc.layer_names();
     let tmp = start(out)?;
@@ -88,6 +90,40 @@ pub fn render(run: &Run, shard: ShardId, out: &Path) -> Result<Manifest, String>
     };
     publish(&tmp, out, &m)?;
     Ok(m)
+}
+
+/// Refuses a shard count that leaves some shard of the set without a block: blocks are never
+/// split, so more shards than blocks (or uneven blocks split too finely) make empty shards,
+/// which every task of the set would publish as finished work. The whole set is checked, not
+/// only `shard`, so that its tasks all run or all refuse.
+fn check_split(blocks: &[Range<u64>], unit: &str, shard: ShardId) -> Result<(), String> {
+    let end = blocks.last().map_or(0, |r| r.end);
+    let n = blocks.len();
+    if shard.count as usize > n {
+        return Err(format!(
+            "--shard {shard}: the run has {n} blocks ({end} {unit}), which {} shards cannot \
+             share without empty ones; N must be at most {n}",
+            shard.count
+        ));
+    }
+    let empty = |count: u32| {
+        (0..count)
+            .map(|index| ShardId { index, count })
+            .find(|s| s.blocks(blocks, end).is_empty())
+    };
+    if let Some(e) = empty(shard.count) {
+        // At most n tries of at most n shards each: n is the path tracer's few passes here
+        // (blocks of equal size, splatting's passes, never leave a shard empty).
+        let fits = (1..shard.count)
+            .rev()
+            .find(|&c| empty(c).is_none())
+            .unwrap_or(1);
+        return Err(format!(
+            "--shard {shard}: the run's {n} blocks ({end} {unit}, of uneven sizes) leave shard \
+             {e} without one; N must be at most {fits} here"
+        ));
+    }
+    Ok(())
 }
 
 /// `merge`: the shards `inputs` put back together into `out`: photon sets into `out` as a
@@ -168,6 +204,22 @@ fn merge_image(all: &[Input], order: &[usize], out: &Path) -> Result<String, Str
                 s.height,
                 s.planes.len(),
                 nb * nl
+            ));
+        }
+        // The checksum only says the bytes are the ones written: a NaN written with its CRC
+        // resealed would pass it, and turn every pixel it is added to into NaN.
+        if let Some((k, i, v)) = s.planes.iter().enumerate().find_map(|(k, p)| {
+            p.iter()
+                .position(|v| !v.iter().all(|c| c.is_finite()))
+                .map(|i| (k, i, p[i]))
+        }) {
+            return Err(format!(
+                "{}: plane {k} (layer {}), pixel ({}, {}) holds {:?}: a render's sums are finite",
+                path.display(),
+                a.m.layers.get(k % nl.max(1)).map_or("?", |l| l.as_str()),
+                i % w.max(1),
+                i / w.max(1),
+                v
             ));
         }
         sums.push(s);

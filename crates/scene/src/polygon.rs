@@ -5,7 +5,9 @@
 //! the BVH over them degenerates (loading such a face took 31 s, a million vertices an hour).
 //! Here a convex face (found in O(n log n)) is split in halves recursively: n - 2 triangles, most of
 //! them small and local. Non-convex faces are ear-clipped, which is quadratic or worse in their
-//! size, so only up to [`MAX_NONCONVEX`] vertices; larger ones are refused with a clear error.
+//! size, so only up to [`MAX_NONCONVEX`] corners; larger ones are refused with a clear error.
+//! Vertices that lie inside a straight edge are no corners: a large face is triangulated
+//! without them (in O(n)), as their triangles would have no area.
 
 // A decoder of untrusted bytes: no input may reach a panic, so the lints that find the ways
 // to one (unwrap, expect, indexing, explicit panics) are errors here; `cargo clippy` is the
@@ -23,8 +25,8 @@
 
 use glam::{DVec2, DVec3, Vec3};
 
-/// Largest non-convex face that is ear-clipped (at most n^3 / 6 point tests: about 3M here,
-/// milliseconds). Larger non-convex faces are refused instead of hanging the load.
+/// Largest non-convex face that is ear-clipped, in corners (at most n^3 / 6 point tests: about
+/// 3M here, milliseconds). Larger non-convex faces are refused instead of hanging the load.
 pub const MAX_NONCONVEX: usize = 256;
 
 /// Convex faces up to this size are fanned from their first vertex exactly as tobj did, so
@@ -49,6 +51,30 @@ pub(crate) fn triangulate(
         _ => {}
     }
     let n = face.len();
+    // Vertices inside straight edges add only zero-area triangles, and a BVH over many of
+    // those (a square of 400k vertices along its edges) took minutes to build: triangulate the
+    // corners. Faces up to `FAN_MAX` keep every vertex, and the triangles they always had.
+    let corners;
+    let face = if n > FAN_MAX {
+        corners = drop_straight(face, pos)?;
+        match corners.as_slice() {
+            // No area at all: one triangle of it keeps it in sight of the checks that refuse
+            // such faces (a zero-area light), instead of n - 2 of them.
+            [] | [_] | [_, _] => {
+                if let [a, b, c, ..] = *face {
+                    out.push([a, b, c]);
+                }
+                return Ok(());
+            }
+            &[a, b, c] => {
+                out.push([a, b, c]);
+                return Ok(());
+            }
+            c => c,
+        }
+    } else {
+        face
+    };
     let p = project(face, pos)?;
     if is_convex(&p) {
         if let Some((&first, rest)) = face.split_first()
@@ -62,14 +88,87 @@ pub(crate) fn triangulate(
         }
         return Ok(());
     }
-    if n > MAX_NONCONVEX {
+    let m = face.len();
+    if m > MAX_NONCONVEX {
+        let corners = if m < n {
+            format!(" ({m} of them corners, the rest inside straight edges)")
+        } else {
+            String::new()
+        };
         return Err(format!(
-            "a non-convex face of {n} vertices: photonflow triangulates non-convex faces of at \
-             most {MAX_NONCONVEX} vertices (split it into smaller faces)"
+            "a non-convex face of {n} vertices{corners}: photonflow triangulates non-convex \
+             faces of at most {MAX_NONCONVEX} corners (split it into smaller faces)"
         ));
     }
     ear_clip(face, &p, out);
     Ok(())
+}
+
+/// The face without the vertices that lie strictly inside the straight segment between their
+/// neighbours (in 3D, exactly: the cross product of the two edges is zero and they point the
+/// same way), nor those that repeat the vertex before them. Each removal keeps the face's
+/// boundary point for point, so its triangles cover the same surface. One pass with a stack
+/// (whole runs go, each vertex popped at most once), then the same across the wrap-around.
+/// In 3D, not in the plane `project` picks: a face that is not planar may look straight
+/// there and still bend.
+fn drop_straight(face: &[u32], pos: &[Vec3]) -> Result<Vec<u32>, String> {
+    let at = |i: u32| -> Result<DVec3, String> {
+        pos.get(i as usize).map(|p| p.as_dvec3()).ok_or_else(|| {
+            format!(
+                "vertex {} is out of range ({} vertices)",
+                i as u64 + 1,
+                pos.len()
+            )
+        })
+    };
+    // `b` strictly between `a` and `c` on one line; f32 coordinates are exact in f64, so
+    // collinear ones give exactly zero.
+    let straight = |a: DVec3, b: DVec3, c: DVec3| {
+        let (u, v) = (b - a, c - b);
+        u.cross(v) == DVec3::ZERO && u.dot(v) > 0.0
+    };
+    let mut out: Vec<(u32, DVec3)> = Vec::with_capacity(face.len());
+    for &i in face {
+        let q = at(i)?;
+        if out.last().is_some_and(|&(_, t)| t == q) {
+            continue;
+        }
+        while let Some(&[(_, a), (_, b)]) = out.last_chunk::<2>() {
+            if straight(a, b, q) {
+                out.pop();
+            } else {
+                break;
+            }
+        }
+        out.push((i, q));
+    }
+    // The wrap-around: the last vertices against the first, then the first against the last.
+    let mut first = 0;
+    loop {
+        let m = out.len() - first;
+        let (Some(&(_, f)), Some(&(_, f2))) = (out.get(first), out.get(first + 1)) else {
+            break;
+        };
+        if m < 3 {
+            break;
+        }
+        if let Some(&[(_, a), (_, b)]) = out.last_chunk::<2>()
+            && (b == f || straight(a, b, f))
+        {
+            out.pop();
+            continue;
+        }
+        match out.last() {
+            Some(&(_, z)) if straight(z, f, f2) => first += 1,
+            _ => break,
+        }
+    }
+    Ok(out
+        .get(first..)
+        .unwrap_or_default()
+        .iter()
+        .map(|&(i, _)| i)
+        .collect())
 }
 
 /// Each vertex with the next one, the last with the first.
