@@ -464,6 +464,27 @@ fn cases() -> Vec<Case> {
             check: absent("out"),
         },
         Case {
+            name: "evidence --only of no technique",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "evidence {d}/s.toml --quick --only bogus --reference-spp 1 --out {d}/out",
+            code: 1,
+            words: &["--only bogus", "no such technique"],
+            // Refused before the reference is rendered: nothing written.
+            check: absent("out"),
+        },
+        Case {
+            name: "evidence --reference-spp 0",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "evidence {d}/s.toml --quick --reference-spp 0 --out {d}/out",
+            code: 1,
+            words: &["--reference-spp 0"],
+            check: absent("out"),
+        },
+        Case {
             name: "evidence with a reference of the wrong size",
             files: with(good(), "ref.exr", Input::Exr(grey(16, 8))),
             setup: vec![],

@@ -446,6 +446,25 @@ pub fn run(a: &EvidenceArgs) -> Result<Measured, String> {
             a.seeds
         ));
     }
+    // Every flag is checked before anything is rendered or written (a bad name used to be
+    // refused only after the reference was rendered and kept).
+    if a.reference.is_none() && !(1..=1 << 24).contains(&a.reference_spp) {
+        return Err(format!(
+            "--reference-spp {} must be in 1..=16777216",
+            a.reference_spp
+        ));
+    }
+    let known: Vec<String> = techniques(a.quick)
+        .iter()
+        .map(|t| slug(t.name))
+        .chain(["k-sweep".to_string()])
+        .collect();
+    if let Some(o) = a.only.iter().find(|o| !known.contains(&slug(o))) {
+        return Err(format!(
+            "--only {o}: no such technique (known: {})",
+            known.join(", ")
+        ));
+    }
     if !(a.budget_scale > 0.0 && a.budget_scale <= 1e3) {
         return Err(format!(
             "--budget-scale {} must be in (0, 1000]",
@@ -479,17 +498,6 @@ pub fn run(a: &EvidenceArgs) -> Result<Measured, String> {
         skipped: Vec::new(),
     };
     let wanted = |name: &str| a.only.is_empty() || a.only.iter().any(|o| slug(o) == slug(name));
-    let known: Vec<String> = techniques(a.quick)
-        .iter()
-        .map(|t| slug(t.name))
-        .chain(["k-sweep".to_string()])
-        .collect();
-    if let Some(o) = a.only.iter().find(|o| !known.contains(&slug(o))) {
-        return Err(format!(
-            "--only {o}: no such technique (known: {})",
-            known.join(", ")
-        ));
-    }
     for mut t in techniques(a.quick).into_iter().filter(|t| wanted(t.name)) {
         t.ladder = t.ladder.iter().map(|&n| scale(n)).collect();
         t.ladder.dedup();
