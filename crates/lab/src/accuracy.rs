@@ -105,7 +105,7 @@ fn corrected(halves: Option<&film::Halves>, exr: &Path) -> Result<String, String
     let Some(h) = halves else {
         return Ok(String::new());
     };
-    let img = render::output::read_finite(exr)?;
+    let img = render::output::read_finite(exr, "pixels")?;
     let m = film::metrics_halves(&img, h, None).map_err(|e| format!("{}: {e}", exr.display()))?;
     Ok(format!("  (reference noise out: {:.5})", m.relmse))
 }

@@ -372,19 +372,7 @@ fn reference(scene: &Scene, a: &EvidenceArgs) -> Result<Reference, String> {
         a.threads,
     )?
     .exr;
-    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-    let read = |p: &Path| -> Result<Image, String> {
-        let img = film::read_exr(p).map_err(|e| e.to_string())?;
-        if (img.width, img.height) != (w, h) {
-            return Err(format!(
-                "{}: reference is {}x{}, the scene renders {w}x{h}",
-                p.display(),
-                img.width,
-                img.height
-            ));
-        }
-        Ok(img)
-    };
+    let read = |p: &Path| render::read_reference(scene, p);
     if let Some(b) = &a.reference_b {
         let Some(first) = &a.reference else {
             return Err(format!(

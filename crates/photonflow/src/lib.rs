@@ -607,7 +607,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
             exposure,
         } => composite::run(&inputs, &out, exposure),
         Cmd::Compare { a, b, b2, mask } => {
-            let img = render::output::read_finite(&a)?;
+            let img = render::output::read_finite(&a, "pixels")?;
             let (text, reference) = match b2 {
                 Some(b2) => {
                     let (m, mean) = render::output::compare_halves(&a, &b, &b2, mask)?;
@@ -615,7 +615,7 @@ fn run(cmd: Cmd) -> Result<(), String> {
                 }
                 None => (
                     render::output::compare(&a, &b, mask)?.to_string(),
-                    render::output::read_finite(&b)?,
+                    render::output::read_finite(&b, "pixels")?,
                 ),
             };
             let flip = render::output::compare_flip(&img, &reference, mask)

@@ -383,13 +383,6 @@ fn resolve(p: &Path) -> Option<PathBuf> {
     Some(real)
 }
 
-pub fn same_dir(a: &Path, b: &Path) -> bool {
-    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => false,
-    }
-}
-
 fn parse_hex(s: &str, file: &Path) -> Result<u64, String> {
     u64::from_str_radix(s, 16).map_err(|_| format!("{}: `{s}` is not a hash", file.display()))
 }

@@ -43,13 +43,7 @@ pub fn write(
     };
     // A run stopped by a time budget is reproduced by the passes it made.
     let settings = &settings.with_made(r);
-    let resolved = settings.resolved_scene(scene)?;
-    let scene_text = toml::to_string(&resolved).map_err(|e| {
-        format!(
-            "{}: the resolved scene does not serialise: {e}",
-            scene.path.display()
-        )
-    })?;
+    let scene_text = settings.resolved_scene_text(scene)?;
     let tone = ToneMap {
         exposure: o.exposure,
         ..ToneMap::default()
@@ -201,8 +195,8 @@ pub fn compare_flip(a: &Image, b: &Image, mask: Option<[usize; 4]>) -> Result<f6
 }
 
 /// A linear EXR to compare, refused if it holds NaN or infinity (errors against it would be
-/// NaN).
-pub fn read_finite(p: &Path) -> Result<Image, String> {
+/// NaN); `what` names its pixels in the message ("pixels", "reference pixels").
+pub fn read_finite(p: &Path, what: &str) -> Result<Image, String> {
     let img = read_exr(p)?;
     let bad = img
         .data
@@ -211,7 +205,7 @@ pub fn read_finite(p: &Path) -> Result<Image, String> {
         .count();
     if bad > 0 {
         return Err(format!(
-            "{}: {bad} of {} pixels are not finite (NaN or infinity): errors against it are \
+            "{}: {bad} of {} {what} are not finite (NaN or infinity): errors against it are \
              undefined",
             p.display(),
             img.data.len()
@@ -242,7 +236,7 @@ pub fn mask_of(p: &Path, img: &Image, mask: Option<[usize; 4]>) -> Result<Option
 
 /// Error metrics of image `a` against reference `b` (linear EXR files), inside `mask`.
 pub fn compare(a: &Path, b: &Path, mask: Option<[usize; 4]>) -> Result<film::Metrics, String> {
-    let (ia, ib) = (read_finite(a)?, read_finite(b)?);
+    let (ia, ib) = (read_finite(a, "pixels")?, read_finite(b, "pixels")?);
     let mask = mask_of(a, &ia, mask)?;
     film::metrics(&ia, &ib, mask.as_ref()).map_err(|e| format!("{}: {e}", b.display()))
 }
@@ -256,8 +250,8 @@ pub fn compare_halves(
     b2: &Path,
     mask: Option<[usize; 4]>,
 ) -> Result<(film::HalvesMetrics, Image), String> {
-    let ia = read_finite(a)?;
-    let halves = film::Halves::new(&read_finite(b1)?, &read_finite(b2)?)
+    let ia = read_finite(a, "pixels")?;
+    let halves = film::Halves::new(&read_finite(b1, "pixels")?, &read_finite(b2, "pixels")?)
         .map_err(|e| format!("{} and {}: {e}", b1.display(), b2.display()))?;
     let mask = mask_of(a, &ia, mask)?;
     let m = film::metrics_halves(&ia, &halves, mask.as_ref())

@@ -484,6 +484,16 @@ impl Settings {
         })
     }
 
+    /// [`Settings::resolved_scene`] as the text of a scene file.
+    pub fn resolved_scene_text(&self, scene: &Scene) -> Result<String, String> {
+        toml::to_string(&self.resolved_scene(scene)?).map_err(|e| {
+            format!(
+                "{}: the resolved scene does not serialise: {e}",
+                scene.path.display()
+            )
+        })
+    }
+
     /// The scene file with these settings written in, mesh paths made absolute: rendering it
     /// again reproduces the run bit for bit (the thread count never changes an image).
     pub fn resolved_scene(&self, scene: &Scene) -> Result<SceneFile, String> {

@@ -34,13 +34,7 @@ pub fn render(run: &Run, shard: ShardId, out: &Path) -> Result<Manifest, String>
                 .into(),
         );
     }
-    let resolved = settings.resolved_scene(scene)?;
-    let scene_text = toml::to_string(&resolved).map_err(|e| {
-        format!(
-            "{}: the resolved scene does not serialise: {e}",
-            scene.path.display()
-        )
-    })?;
+    let scene_text = settings.resolved_scene_text(scene)?;
     let mut b = blocks_fn(run);
     let total = b.blocks.len() as u64;
     check_split(&b.blocks, b.unit, shard)?;

@@ -202,9 +202,8 @@ impl crate::passes::Progressive for Sppm<'_> {
         )
     }
 
-    fn finish(&self, _seconds: f64) -> Rendered {
+    fn finish(&self, seconds: f64) -> Rendered {
         let sp = &self.run.settings.estimate.sppm;
-        let seconds = self.t0.elapsed().as_secs_f64();
         let passes = self.passes;
         let mut info = serde_json::Map::new();
         let stats = &self.stats;
