@@ -594,14 +594,14 @@ fn params_round_trip_and_reject_unknown_keys() {
     let p = EmitParams::default();
     assert_eq!(
         (p.photons, p.max_depth, p.store_direct, p.global, p.caustic),
-        (200_000, 16, true, true, true)
+        (200_000, 64, true, true, true)
     );
     let text = toml::to_string(&p).unwrap();
     assert_eq!(toml::from_str::<EmitParams>(&text).unwrap(), p);
     let partial: EmitParams = toml::from_str("photons = 5\nstore_direct = false").unwrap();
     assert_eq!(
         (partial.photons, partial.store_direct, partial.max_depth),
-        (5, false, 16)
+        (5, false, 64)
     );
     assert!(toml::from_str::<EmitParams>("photon = 5").is_err());
 }

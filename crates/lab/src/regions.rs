@@ -7,10 +7,18 @@ use film::Mask;
 use glam::Vec3;
 use scene::{Material, Scene};
 
+/// Whether `material` is a surface photons land on and estimates are made at: diffuse and
+/// not an emitter. A light's own pixels are left out of every region but the whole image:
+/// one sample per pixel at its edge flips between the light and the ceiling, which would
+/// drown the walls' statistics, and its edges are no rim of the box.
+fn receives(scene: &Scene, material: u32) -> bool {
+    scene.is_diffuse(material) && scene.emission[material as usize] == Vec3::ZERO
+}
+
 /// The named regions of an image of `scene`, from its geometry: the caustic under the glass
 /// sphere, the inner edges and corners of the box, its outer rim (the open front), the glass
 /// sphere, the open walls (diffuse surfaces away from edges and caustics), and the whole
-/// image.
+/// image. Every region but the whole image leaves out the pixels that see a light.
 pub fn regions(scene: &Scene) -> Vec<(&'static str, Mask)> {
     let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
     let caustic = caustic_region(scene, 1.6);
@@ -40,15 +48,41 @@ pub fn regions(scene: &Scene) -> Vec<(&'static str, Mask)> {
         !caustic.pixels[i]
             && !inner.pixels[i]
             && !rim.pixels[i]
-            && seen(x, y).is_some_and(|hit| scene.is_diffuse(hit.material))
+            && seen(x, y).is_some_and(|hit| receives(scene, hit.material))
     });
+    // Pixels that see an emitter anywhere in their footprint (centre and four points near the
+    // corners): a sample or two per pixel either hits the light or misses it, so at the
+    // light's outline one run's pixel reads a fraction of the light or none; left in, those
+    // few pixels would swing a region's mean by a percent.
+    let near_light = Mask::from_fn(w, h, |x, y| {
+        [
+            (0.5, 0.5),
+            (0.02, 0.02),
+            (0.98, 0.02),
+            (0.02, 0.98),
+            (0.98, 0.98),
+        ]
+        .iter()
+        .any(|&(dx, dy)| {
+            let ray = scene.camera.ray(x as f32 + dx, y as f32 + dy);
+            scene
+                .geometry
+                .intersect(&ray)
+                .is_some_and(|hit| scene.emission[hit.material as usize] != Vec3::ZERO)
+        })
+    });
+    let away = |m: Mask| {
+        Mask::from_fn(w, h, |x, y| {
+            m.pixels[y * w + x] && !near_light.pixels[y * w + x]
+        })
+    };
     vec![
         ("image", Mask::all(w, h)),
-        ("caustic", caustic),
-        ("edges and corners", edges),
-        ("outer rim", rim),
-        ("glass sphere", glass),
-        ("open walls", walls),
+        ("caustic", away(caustic)),
+        ("edges and corners", away(edges)),
+        ("outer rim", away(rim)),
+        ("glass sphere", away(glass)),
+        ("open walls", away(walls)),
     ]
 }
 
@@ -97,7 +131,7 @@ pub fn edge_mask(scene: &Scene, band: f32) -> Mask {
             matches!(
                 scene.materials[mesh.materials[t] as usize],
                 Material::Lambertian { .. }
-            )
+            ) && receives(scene, mesh.materials[t])
         })
         .collect();
     Mask::from_fn(w, h, |x, y| {
@@ -110,7 +144,8 @@ pub fn edge_mask(scene: &Scene, band: f32) -> Mask {
         if !matches!(
             scene.materials[hit.material as usize],
             Material::Lambertian { .. }
-        ) {
+        ) || !receives(scene, hit.material)
+        {
             return false;
         }
         walls.iter().any(|&t| {
@@ -134,7 +169,7 @@ pub fn rim_mask(scene: &Scene, band: f32) -> Mask {
     let eps = 1e-5 * (b.max - b.min).length();
     let mut rim: Vec<(Vec3, Vec3)> = Vec::new();
     for t in 0..mesh.len() {
-        if !scene.is_diffuse(mesh.materials[t]) {
+        if !receives(scene, mesh.materials[t]) {
             continue;
         }
         let v = mesh.vertices(t);
@@ -155,7 +190,7 @@ pub fn rim_mask(scene: &Scene, band: f32) -> Mask {
         else {
             return false;
         };
-        scene.is_diffuse(hit.material)
+        receives(scene, hit.material)
             && rim
                 .iter()
                 .any(|&(a, c)| point_segment_distance(hit.point.p, a, c) < band)
