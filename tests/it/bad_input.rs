@@ -1404,13 +1404,13 @@ fn cases() -> Vec<Case> {
         // Temporary files.
         Case {
             name: "a stale temp file of a dead process",
-            files: with(good(), "cache/x.photons.tmp-999999999-0", text("partial")),
+            files: with(good(), "cache/.x.photons.tmp-999999999-0", text("partial")),
             setup: vec![],
             prepare: None,
             args: "trace {d}/s.toml --photons 2000 --cache {d}/cache",
             code: 0,
             words: &[],
-            check: absent("cache/x.photons.tmp-999999999-0"),
+            check: absent("cache/.x.photons.tmp-999999999-0"),
         },
     ]
 }

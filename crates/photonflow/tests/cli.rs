@@ -713,5 +713,5 @@ fn interrupted_traces_leave_no_temp_files() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(temps().is_empty(), "stale temp file kept: {:?}", temps());
     let e = String::from_utf8_lossy(&o.stderr);
-    assert!(e.contains("an unfinished photon file of process"), "{e}");
+    assert!(e.contains("an unfinished file of process"), "{e}");
 }
