@@ -1,9 +1,10 @@
 //! Image files: linear float EXR, tone-mapped 8-bit PNG, and atomic replacement on disk.
 //!
-//! Every writer encodes into memory first, then writes a temporary file in the target's
-//! directory and renames it over the target. A rename within one directory is atomic on
-//! POSIX file systems, so readers (and a later run after a crash) see either the old file
-//! or the complete new one, never a truncated image.
+//! Every writer encodes into a temporary file beside the target (a `temps::Temp`: removed on
+//! failure, on a signal, or by a later run once this process is gone) and renames it over the
+//! target. A rename within one directory is atomic on POSIX file systems, so readers (and a
+//! later run after a crash) see either the old file or the complete new one, never a truncated
+//! image. Encoding straight into the file keeps no second copy of the image in memory.
 
 // A decoder of untrusted bytes: no input may reach a panic, so the lints that find the ways
 // to one (unwrap, expect, indexing, explicit panics) are errors here; `cargo clippy` is the
@@ -19,10 +20,9 @@
     )
 )]
 
-use std::fs;
-use std::io::{Cursor, Write};
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
 
 use crate::{FilmError, Image};
 
@@ -76,15 +76,15 @@ pub fn write_exr(path: impl AsRef<Path>, img: &Image) -> Result<(), FilmError> {
         Encoding::SMALL_LOSSLESS,
         channels,
     );
-    let mut bytes = Cursor::new(Vec::new());
-    image
-        .write()
-        .to_buffered(&mut bytes)
-        .map_err(|source| FilmError::Exr {
-            path: path.to_owned(),
-            source,
-        })?;
-    write_atomic(path, bytes.get_ref())
+    write_atomic_with(path, |file| {
+        image
+            .write()
+            .to_buffered(file)
+            .map_err(|source| FilmError::Exr {
+                path: path.to_owned(),
+                source,
+            })
+    })
 }
 
 /// Reads the first RGB(A) layer of an OpenEXR file as linear f32 RGB (alpha is dropped).
@@ -98,7 +98,7 @@ pub fn read_exr(path: impl AsRef<Path>) -> Result<Image, FilmError> {
     // could hold first. Deflate, EXR's strongest lossless stage, expands at most 1032:1
     // (RFC 1951: a 258-byte match per 2 bits), so a pixel of three f32 channels needs over
     // 1/100 byte; 128 pixels per byte, plus a million pixels, is room for any real file.
-    let len = fs::metadata(path)
+    let len = std::fs::metadata(path)
         .map_err(|source| FilmError::Io {
             path: path.to_owned(),
             what: "read",
@@ -151,50 +151,47 @@ pub fn write_png(path: impl AsRef<Path>, img: &Image, tone: &ToneMap) -> Result<
     };
     let w = u32::try_from(img.width).map_err(|_| too_big())?;
     let h = u32::try_from(img.height).map_err(|_| too_big())?;
-    let pixels: Vec<u8> = img.data.iter().flatten().map(|&v| tone.apply(v)).collect();
-    let mut bytes = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut bytes)
-        .write_image(&pixels, w, h, image::ExtendedColorType::Rgb8)
-        .map_err(png_err)?;
-    write_atomic(path, &bytes)
+    write_atomic_with(path, |file| {
+        let pixels: Vec<u8> = img.data.iter().flatten().map(|&v| tone.apply(v)).collect();
+        image::codecs::png::PngEncoder::new(file)
+            .write_image(&pixels, w, h, image::ExtendedColorType::Rgb8)
+            .map_err(png_err)
+    })
 }
 
 /// Writes `bytes` to `path` via a temporary file in the same directory plus a rename.
 /// On failure the temporary file is removed and `path` is untouched.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FilmError> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let err = |what, source| FilmError::Io {
+    write_atomic_with(path, |file| {
+        file.write_all(bytes)
+            .map_err(|e| io_error(path, "write temporary file", e))
+    })
+}
+
+fn io_error(path: &Path, what: &'static str, source: std::io::Error) -> FilmError {
+    FilmError::Io {
         path: path.to_owned(),
         what,
         source,
-    };
-    let Some(name) = path.file_name() else {
-        return Err(err(
-            "write: path has no file name",
-            std::io::Error::from(std::io::ErrorKind::InvalidInput),
-        ));
-    };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let tmp: PathBuf = dir.join(format!(
-        ".{}.{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let mut file = fs::File::create_new(&tmp).map_err(|e| err("create temporary file", e))?;
-    let written = file
-        .write_all(bytes)
-        .and_then(|()| file.sync_all())
-        .map_err(|e| err("write temporary file", e));
-    drop(file);
-    let renamed = written.and_then(|()| {
-        fs::rename(&tmp, path).map_err(|e| err("rename temporary file into place", e))
-    });
-    if renamed.is_err() {
-        let _ = fs::remove_file(&tmp);
     }
-    renamed
+}
+
+/// [`write_atomic`] of what `write` writes into the (buffered) temporary file.
+fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<File>) -> Result<(), FilmError>,
+) -> Result<(), FilmError> {
+    let (tmp, file) =
+        temps::Temp::file(path).map_err(|e| io_error(path, "create temporary file", e))?;
+    let mut buffered = BufWriter::new(file);
+    write(&mut buffered)?;
+    let file = buffered
+        .into_inner()
+        .map_err(|e| io_error(path, "write temporary file", e.into_error()))?;
+    // Data on disk before the name: after a crash the renamed file is complete.
+    file.sync_all()
+        .map_err(|e| io_error(path, "write temporary file", e))?;
+    drop(file);
+    tmp.publish(path)
+        .map_err(|e| io_error(path, "rename temporary file into place", e))
 }

@@ -140,6 +140,12 @@ fn write(c: &::composite::Composite, out: &Path, exposure: f32) -> Result<(), St
 
     std::fs::create_dir_all(out.join("layers"))
         .map_err(|e| format!("{}: cannot create output directory: {e}", out.display()))?;
+    // A run killed mid-write (kill -9) left its temp files: no run will finish or read them.
+    for dir in [out.to_path_buf(), out.join("layers")] {
+        for stale in temps::remove_stale(&dir) {
+            eprintln!("{stale}");
+        }
+    }
     for l in &c.layers {
         film::write_exr(out.join("layers").join(format!("{}.exr", l.name)), &l.image)
             .map_err(|e| e.to_string())?;

@@ -4,22 +4,23 @@
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    // Ctrl-C (or a termination signal) removes the photon files being written before it
-    // ends the process, as the default action would, with the shell's code for SIGINT.
-    // Files already published are complete (they are renamed into place whole).
+    // Ctrl-C (or a termination signal) removes the files and staging directories being
+    // written (photon files, images, shards) before it ends the process, as the default
+    // action would, with the shell's code for SIGINT. What is already published is complete
+    // (renamed into place whole).
     let _ = ctrlc::set_handler(|| {
-        let n = store::remove_live_temp_files();
-        eprintln!("interrupted: removed {n} unfinished photon file(s)");
+        let removed = temps::remove_live_before_exit();
+        eprintln!("interrupted: removed {removed}");
         std::process::exit(130);
     });
     // Rust ignores SIGPIPE, so once a reader closes our stdout (`photonflow ... | head`) every
     // `println!` panics. End as a C tool killed by SIGPIPE would instead: no message, the
-    // status a shell reports for it (128 + 13), and no unfinished photon file left behind.
+    // status a shell reports for it (128 + 13), and no unfinished file left behind.
     let default_hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
         let msg = info.payload_as_str().unwrap_or("");
         if msg.starts_with("failed printing to stdout") && msg.contains("Broken pipe") {
-            store::remove_live_temp_files();
+            temps::remove_live_before_exit();
             std::process::exit(141);
         }
         default_hook(info);

@@ -713,5 +713,250 @@ fn interrupted_traces_leave_no_temp_files() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(temps().is_empty(), "stale temp file kept: {:?}", temps());
     let e = String::from_utf8_lossy(&o.stderr);
-    assert!(e.contains("an unfinished photon file of process"), "{e}");
+    assert!(e.contains("an unfinished file of process"), "{e}");
+}
+
+/// The temp files and staging directories (`temps`' names) under `dir`, as paths relative to
+/// it; a staging directory is listed, not entered.
+#[cfg(unix)]
+fn temps_under(dir: &std::path::Path) -> Vec<String> {
+    let mut found = Vec::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let rel = e.path().strip_prefix(dir).unwrap().display().to_string();
+            if temps::owner(&name).is_some() {
+                found.push(rel);
+            } else if e.file_type().is_ok_and(|t| t.is_dir()) {
+                todo.push(e.path());
+            }
+        }
+    }
+    found.sort();
+    found
+}
+
+/// The furnace scene at `size` x `size` pixels, written into `dir`: big enough that encoding
+/// each of its images takes a while, during which its temp file exists.
+#[cfg(unix)]
+fn big_furnace(dir: &Scratch, size: u32) -> String {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/furnace");
+    let text = std::fs::read_to_string(format!("{root}/furnace.toml"))
+        .unwrap()
+        .replace("width = 32", &format!("width = {size}"))
+        .replace("height = 32", &format!("height = {size}"))
+        .replace("obj = \"box.obj\"", &format!("obj = \"{root}/box.obj\""));
+    let path = dir.0.join("furnace.toml");
+    std::fs::write(&path, text).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+/// How an interrupt test's run ended.
+#[cfg(unix)]
+struct Interrupted {
+    status: std::process::ExitStatus,
+    /// `.tmp-<pid>-`: what this run's temps hold in their names.
+    mine: String,
+}
+
+/// Runs photonflow with `args` and sends it `signal` once `ready` holds for the temps under
+/// `watch` (polled, so the moment does not depend on the machine's speed).
+#[cfg(unix)]
+fn interrupt(
+    args: &[&str],
+    watch: &std::path::Path,
+    ready: &mut dyn FnMut(&[String], &str) -> bool,
+    signal: nix::sys::signal::Signal,
+) -> Interrupted {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_photonflow"))
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let mine = format!(".tmp-{}-", child.id());
+    let t0 = std::time::Instant::now();
+    while !ready(&temps_under(watch), &mine) {
+        // Neither bound is a measurement: they only keep a broken run from hanging the test.
+        assert!(
+            t0.elapsed().as_secs() < 300,
+            "{args:?}: the moment never came"
+        );
+        let done = child.try_wait().unwrap();
+        assert!(done.is_none(), "{args:?} ended before the moment: {done:?}");
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    let pid = nix::unistd::Pid::from_raw(child.id() as i32);
+    nix::sys::signal::kill(pid, signal).unwrap();
+    Interrupted {
+        status: child.wait().unwrap(),
+        mine,
+    }
+}
+
+/// Signals `args`, a run writing a run directory at `out`, while it writes the k-th temp file
+/// there (k from `plan`), and checks that SIGINT removes what it was writing and that a
+/// kill -9's temp files stay until the next run into `out`, which removes them.
+#[cfg(unix)]
+fn interrupt_while_writing(args: &[&str], out: &std::path::Path) {
+    use nix::sys::signal::Signal::{SIGINT, SIGKILL};
+    // Ending with a kill -9, whose files the rerun must remove.
+    let plan = [
+        (0, SIGINT),
+        (1, SIGKILL),
+        (2, SIGINT),
+        (0, SIGKILL),
+        (1, SIGINT),
+        (2, SIGKILL),
+    ];
+    for (k, signal) in plan {
+        // Every temp file of this run seen so far: the k-th has appeared once there are k + 1.
+        let mut seen = std::collections::BTreeSet::new();
+        let r = interrupt(
+            args,
+            out,
+            &mut |temps, mine| {
+                seen.extend(temps.iter().filter(|t| t.contains(mine)).cloned());
+                seen.len() > k
+            },
+            signal,
+        );
+        // The run never finished: `image.json`, written last, says a directory is complete.
+        assert!(!out.join("image.json").exists(), "{signal} at file {k}");
+        let left = temps_under(out);
+        if signal == SIGINT {
+            // Its own temp files removed on the signal, and a killed run's before it began
+            // writing (their process is gone).
+            assert_eq!(r.status.code(), Some(130), "{signal} at file {k}");
+            assert!(left.is_empty(), "{signal} at file {k} left {left:?}");
+        } else {
+            // kill -9 cannot clean up: its temp file stays until the next run.
+            assert!(left.iter().any(|t| t.contains(&r.mine)), "{left:?}");
+        }
+    }
+    let o = photonflow(args);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{e}");
+    assert!(out.join("image.json").exists());
+    assert!(temps_under(out).is_empty(), "kept: {:?}", temps_under(out));
+    assert!(e.contains("an unfinished file of process"), "{e}");
+}
+
+/// Ctrl-C while `render` writes its images removes the ones being written; a kill -9's stay
+/// until the next render into that directory.
+#[cfg(unix)]
+#[test]
+fn interrupted_renders_leave_no_temp_files() {
+    let dir = Scratch::new("interrupt-render", &[]);
+    let scene = big_furnace(&dir, 640);
+    let out = dir.0.join("run");
+    let args = [
+        "render",
+        &scene,
+        "--method",
+        "path",
+        "--spp",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    interrupt_while_writing(&args, &out);
+}
+
+/// Ctrl-C while `merge` writes the image of image shards removes the files being written; a
+/// kill -9's stay until the next merge into that directory.
+#[cfg(unix)]
+#[test]
+fn interrupted_merges_leave_no_temp_files() {
+    let dir = Scratch::new("interrupt-merge", &[]);
+    let scene = big_furnace(&dir, 640);
+    let shard = dir.0.join("shard");
+    let o = photonflow(&[
+        "render",
+        &scene,
+        "--method",
+        "path",
+        "--spp",
+        "1",
+        "--shard",
+        "0/1",
+        "--out",
+        shard.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = dir.0.join("merged");
+    let args = [
+        "merge",
+        shard.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    interrupt_while_writing(&args, &out);
+}
+
+/// Ctrl-C during `render --shard` removes its staging directory (nothing is published); a
+/// kill -9's stays until the shard is written again.
+#[cfg(unix)]
+#[test]
+fn interrupted_shards_leave_no_staging_directories() {
+    use nix::sys::signal::Signal::{SIGINT, SIGKILL};
+    let dir = Scratch::new("interrupt-shard", &[]);
+    let shards = dir.0.join("shards");
+    let out = shards.join("0");
+    let args = |spp| {
+        [
+            "render",
+            "scenes/furnace/furnace.toml",
+            "--method",
+            "path",
+            "--spp",
+            spp,
+            "--shard",
+            "0/2",
+            "--out",
+            out.to_str().unwrap(),
+        ]
+    };
+    // At several moments of the rendering (the staging directory lives from its start, and
+    // this one would take hours), ending with a kill -9 whose directory the last run removes.
+    let plan = [SIGINT, SIGKILL, SIGINT, SIGKILL, SIGKILL, SIGINT, SIGKILL];
+    for (i, signal) in plan.into_iter().enumerate() {
+        let mut polls = 0;
+        let r = interrupt(
+            &args("16777216"),
+            &shards,
+            &mut |temps, mine| {
+                // A few more polls each time: later moments.
+                polls += temps.iter().any(|t| t.contains(mine)) as usize;
+                polls > 20 * i
+            },
+            signal,
+        );
+        assert!(
+            !out.exists(),
+            "{signal} at moment {i}: a shard was published"
+        );
+        let left = temps_under(&shards);
+        if signal == SIGINT {
+            assert_eq!(r.status.code(), Some(130), "{signal} at moment {i}");
+            assert!(left.is_empty(), "{signal} at moment {i} left {left:?}");
+        } else {
+            assert!(left.iter().any(|t| t.contains(&r.mine)), "{left:?}");
+        }
+    }
+    // Another shard's, of a process this machine cannot see (shards of one run share their
+    // directory across machines): not this shard's to remove.
+    let other = ".1.tmp-999999999-0";
+    std::fs::create_dir(shards.join(other)).unwrap();
+    let o = photonflow(&args("2"));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{e}");
+    assert!(out.join("shard.json").is_file());
+    assert_eq!(temps_under(&shards), [other]);
+    assert!(
+        e.contains("an unfinished staging directory of process"),
+        "{e}"
+    );
 }

@@ -131,11 +131,8 @@ pub fn trace(
     std::fs::create_dir_all(dir)
         .map_err(|e| format!("{}: cannot create cache directory: {e}", dir.display()))?;
     // A run killed mid-write (kill -9) left its temp files: no run will finish or read them.
-    for (f, pid) in store::remove_stale_temp_files(dir) {
-        eprintln!(
-            "removed {}: an unfinished photon file of process {pid}, which is gone",
-            f.display()
-        );
+    for stale in temps::remove_stale(dir) {
+        eprintln!("{stale}");
     }
     let write_plan = || {
         film::write_atomic(&key.plan_file(dir), plan.to_string().as_bytes())

@@ -21,6 +21,7 @@ use scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use store::{Header, MapKind, MappedStore, StoreWriter};
+use temps::Temp;
 
 /// The file that describes a shard directory.
 pub const MANIFEST: &str = "shard.json";
@@ -70,9 +71,10 @@ pub fn hex(v: u64) -> String {
     format!("{v:016x}")
 }
 
-/// A fresh temporary directory beside `out`, after refusing an `out` that is something
-/// other than a shard (a shard is replaced whole: a requeued task writes its shard again).
-pub fn start(out: &Path) -> Result<PathBuf, String> {
+/// A fresh staging directory beside `out`, after refusing an `out` that is something other
+/// than a shard (a shard is replaced whole: a requeued task writes its shard again). The
+/// staging directories of `out` whose process is gone (kill -9) are removed first.
+pub fn start(out: &Path) -> Result<Temp, String> {
     if out.exists() && !out.join(MANIFEST).is_file() {
         let empty = std::fs::read_dir(out).is_ok_and(|mut d| d.next().is_none());
         if !empty {
@@ -82,36 +84,45 @@ pub fn start(out: &Path) -> Result<PathBuf, String> {
             ));
         }
     }
-    let name = out
-        .file_name()
-        .ok_or_else(|| format!("{}: --out needs a directory name", out.display()))?;
+    if out.file_name().is_none() {
+        return Err(format!("{}: --out needs a directory name", out.display()));
+    }
     let parent = match out.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    let tmp = parent.join(format!(
-        ".{}.tmp-{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&tmp);
-    std::fs::create_dir_all(&tmp).map_err(|e| format!("{}: cannot create: {e}", tmp.display()))?;
-    Ok(tmp)
+    std::fs::create_dir_all(parent)
+        .map_err(|e| format!("{}: cannot create: {e}", parent.display()))?;
+    for stale in temps::remove_stale_of(out) {
+        eprintln!("{stale}");
+    }
+    Temp::dir(out).map_err(|e| {
+        format!(
+            "{}: cannot create a staging directory beside it: {e}",
+            out.display()
+        )
+    })
 }
 
-/// Writes the manifest last into `tmp`, then renames `tmp` to `out` (an old shard there is
-/// moved aside first and removed after).
-pub fn publish(tmp: &Path, out: &Path, m: &Manifest) -> Result<(), String> {
+/// Writes the manifest last into `tmp`, then renames `tmp` to `out`. An old shard there is
+/// moved aside first and removed after; as a temp itself, it goes too if a signal comes
+/// between the renames.
+pub fn publish(tmp: Temp, out: &Path, m: &Manifest) -> Result<(), String> {
     let text = serde_json::to_string_pretty(m).map_err(|e| e.to_string())? + "\n";
-    film::write_atomic(&tmp.join(MANIFEST), text.as_bytes()).map_err(|e| e.to_string())?;
-    let old = tmp.with_extension("old");
-    if out.exists() {
-        std::fs::rename(out, &old)
-            .map_err(|e| format!("{}: cannot replace: {e}", out.display()))?;
+    film::write_atomic(&tmp.path().join(MANIFEST), text.as_bytes()).map_err(|e| e.to_string())?;
+    let old = if out.exists() {
+        Some(Temp::aside(out).map_err(|e| format!("{}: cannot replace: {e}", out.display()))?)
+    } else {
+        None
+    };
+    if let Err(e) = tmp.publish(out) {
+        // A failed replacement keeps the old shard.
+        if let Some(old) = old {
+            let _ = old.publish(out);
+        }
+        return Err(format!("{}: cannot rename into place: {e}", out.display()));
     }
-    std::fs::rename(tmp, out)
-        .map_err(|e| format!("{}: cannot rename into place: {e}", out.display()))?;
-    let _ = std::fs::remove_dir_all(&old);
+    drop(old);
     Ok(())
 }
 
@@ -142,7 +153,7 @@ pub fn trace(
     let tmp = start(out)?;
     let files: Vec<(MapKind, PathBuf)> = kinds
         .iter()
-        .map(|&k| (k, tmp.join(format!("{}.photons", k.name()))))
+        .map(|&k| (k, tmp.path().join(format!("{}.photons", k.name()))))
         .collect();
     let t0 = std::time::Instant::now();
     let progress = Progress::new("trace shard", range.end - range.start, "photons");
@@ -159,10 +170,8 @@ pub fn trace(
             Ok(())
         },
     );
-    if let Err(e) = done {
-        let _ = std::fs::remove_dir_all(&tmp);
-        return Err(e);
-    }
+    // On failure `tmp` is dropped, and with it what was written.
+    done?;
     // Each file's header counts the shard's paths; its photons carry 1/P of the whole run.
     store.finish(range.end - range.start)?;
     progress.finish();
@@ -184,7 +193,7 @@ pub fn trace(
         count: range.end - range.start,
         seconds: t0.elapsed().as_secs_f64(),
     };
-    publish(&tmp, out, &m)?;
+    publish(tmp, out, &m)?;
     Ok(m)
 }
 
@@ -455,6 +464,10 @@ fn merge_photon_files(all: &[Input], order: &[usize], out: &Path) -> Result<Stri
     };
     std::fs::create_dir_all(out)
         .map_err(|e| format!("{}: cannot create cache directory: {e}", out.display()))?;
+    // A merge killed mid-write (kill -9) left its temp files: no run will finish or read them.
+    for stale in temps::remove_stale(out) {
+        eprintln!("{stale}");
+    }
     let mut written = Vec::new();
     let mut stored = 0;
     for (j, &k) in kinds.iter().enumerate() {

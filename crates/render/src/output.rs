@@ -138,6 +138,12 @@ pub fn write(
     let out = o.out;
     std::fs::create_dir_all(out.join("layers"))
         .map_err(|e| format!("{}: cannot create output directory: {e}", out.display()))?;
+    // A run killed mid-write (kill -9) left its temp files: no run will finish or read them.
+    for dir in [out.to_path_buf(), out.join("layers"), out.join("snapshots")] {
+        for stale in temps::remove_stale(&dir) {
+            eprintln!("{stale}");
+        }
+    }
     // A directory written before holds files this run may not replace (another method's
     // layers, a plan): remove them first, so `image.json`, written last, never describes
     // a mix of two runs, and a run that fails half-way leaves no `image.json` behind.

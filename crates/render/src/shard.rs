@@ -61,8 +61,8 @@ pub fn render(run: &Run, shard: ShardId, out: &Path) -> Result<Manifest, String>
         height: h,
         planes,
     };
-    film::write_sums(&tmp.join(SUMS), &sums).map_err(|e| e.to_string())?;
-    film::write_atomic(&tmp.join("scene.toml"), scene_text.as_bytes())
+    film::write_sums(&tmp.path().join(SUMS), &sums).map_err(|e| e.to_string())?;
+    film::write_atomic(&tmp.path().join("scene.toml"), scene_text.as_bytes())
         .map_err(|e| e.to_string())?;
     let m = Manifest {
         photonflow_shard: VERSION,
@@ -82,7 +82,7 @@ pub fn render(run: &Run, shard: ShardId, out: &Path) -> Result<Manifest, String>
         count,
         seconds: t0.elapsed().as_secs_f64(),
     };
-    publish(&tmp, out, &m)?;
+    publish(tmp, out, &m)?;
     Ok(m)
 }
 

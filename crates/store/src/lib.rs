@@ -22,14 +22,14 @@ mod error;
 mod format;
 mod read;
 mod record;
-mod temp;
+mod space;
 mod write;
 
 pub use error::{Problem, StoreError};
 pub use format::{DEFAULT_CHUNK_PHOTONS, FORMAT_VERSION, Header, RECORD_LAYOUT};
 pub use read::{Expect, MappedStore, StoreReader, check};
 pub use record::{MapKind, PerKind, Photon, oct_decode, oct_encode};
-pub use temp::{free_space, remove_live_temp_files, remove_stale_temp_files, temp_owner};
+pub use space::free_space;
 pub use write::StoreWriter;
 
 #[cfg(test)]

@@ -1,8 +1,7 @@
-use std::ffi::OsString;
-use std::fs::{self, File, OpenOptions};
+use std::fs::File;
 use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use temps::Temp;
 
 use crate::Photon;
 use crate::error::{Problem, StoreError};
@@ -13,27 +12,24 @@ use crate::format::{
 
 /// Streams photons into a photon file in constant memory (one chunk).
 ///
-/// The file is written as `<path>.tmp-<pid>-<n>` with a zeroed magic; [`StoreWriter::finish`]
-/// writes the real header, fsyncs and renames it to `path`. So `path` either holds a complete,
-/// checksummed file or is untouched, whatever happens to this process; dropping an unfinished
-/// writer deletes its temp file, [`crate::remove_live_temp_files`] (a Ctrl-C handler) deletes
-/// every one of this process, and [`crate::remove_stale_temp_files`] those of a dead process
-/// (the pid in the name tells which).
+/// The file is written as a [`temps::Temp`] beside `path` with a zeroed magic;
+/// [`StoreWriter::finish`] writes the real header, fsyncs and renames it to `path`. So `path`
+/// either holds a complete, checksummed file or is untouched, whatever happens to this process;
+/// the temp file is removed when an unfinished writer is dropped, by a signal handler, or by a
+/// later run once this process is gone (see `temps`).
 pub struct StoreWriter {
     path: PathBuf,
-    tmp: PathBuf,
+    /// Closed before `tmp` is removed (field order).
     file: Option<File>,
+    /// `None` once published.
+    tmp: Option<Temp>,
     header: Header,
     capacity: u32,
     /// Payload bytes of the chunk being filled.
     buf: Vec<u8>,
     chunks: u32,
     poisoned: bool,
-    finished: bool,
 }
-
-/// Makes temp names unique between writers of one process (the pid separates processes).
-static TMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 
 impl StoreWriter {
     /// Starts a photon file for `header` (its counts are ignored: `finish` sets them).
@@ -57,26 +53,16 @@ impl StoreWriter {
         }
         header.stored = 0;
         header.emitted = 0;
-        let n = TMP_COUNTER.fetch_add(1, Ordering::Relaxed);
-        let mut tmp = OsString::from(path.as_os_str());
-        tmp.push(format!(".tmp-{}-{n}", std::process::id()));
-        let tmp = PathBuf::from(tmp);
-        let mut file = OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)
-            .map_err(|e| StoreError::io(&tmp, "create", e))?;
-        crate::temp::register(&tmp);
+        let (tmp, mut file) = Temp::file(path).map_err(|e| StoreError::io(path, "create", e))?;
         let mut writer = StoreWriter {
             path: path.to_path_buf(),
-            tmp,
             file: None,
+            tmp: Some(tmp),
             header,
             capacity,
             buf: Vec::with_capacity(capacity as usize * 32),
             chunks: 0,
             poisoned: false,
-            finished: false,
         };
         // Zeros now, the header at `finish`: until then the file has no magic.
         let zeros = vec![0u8; header_len(&writer.header.params)];
@@ -86,15 +72,20 @@ impl StoreWriter {
         Ok(writer)
     }
 
+    /// What messages name: the file being written.
+    fn tmp_path(&self) -> &Path {
+        self.tmp.as_ref().map_or(&self.path, |t| t.path())
+    }
+
     fn fail(&mut self, op: &'static str, e: std::io::Error) -> StoreError {
         self.poisoned = true;
-        StoreError::io(&self.tmp, op, e)
+        StoreError::io(self.tmp_path(), op, e)
     }
 
     /// Appends `photons`, writing each chunk as it fills.
     pub fn write(&mut self, mut photons: &[Photon]) -> Result<(), StoreError> {
         if self.poisoned {
-            return Err(StoreError::new(&self.tmp, Problem::Poisoned));
+            return Err(StoreError::new(self.tmp_path(), Problem::Poisoned));
         }
         while !photons.is_empty() {
             if self.buf.is_empty() && photons.len() >= self.capacity as usize {
@@ -129,7 +120,7 @@ impl StoreWriter {
         if self.chunks == u32::MAX {
             self.poisoned = true;
             let too_many = Problem::Corrupt("too many chunks".into());
-            return Err(StoreError::new(&self.tmp, too_many));
+            return Err(StoreError::new(self.tmp_path(), too_many));
         }
         let mut head = [0u8; CHUNK_HEADER_LEN];
         encode_chunk_header(&mut head, self.chunks, self.header.stored, payload);
@@ -151,7 +142,7 @@ impl StoreWriter {
     /// then an atomic rename to `path` (replacing any file there).
     pub fn finish(mut self, emitted: u64) -> Result<(), StoreError> {
         if self.poisoned {
-            return Err(StoreError::new(&self.tmp, Problem::Poisoned));
+            return Err(StoreError::new(self.tmp_path(), Problem::Poisoned));
         }
         if !self.buf.is_empty() {
             self.flush_chunk()?;
@@ -162,17 +153,17 @@ impl StoreWriter {
         let done = file
             .seek(SeekFrom::Start(0))
             .and_then(|_| file.write_all(&header))
-            .map_err(|e| StoreError::io(&self.tmp, "write", e))
+            .map_err(|e| StoreError::io(self.tmp_path(), "write", e))
             // Data on disk before the name: after a crash the renamed file is complete.
             .and_then(|_| {
                 file.sync_all()
-                    .map_err(|e| StoreError::io(&self.tmp, "sync", e))
+                    .map_err(|e| StoreError::io(self.tmp_path(), "sync", e))
             });
         drop(file);
         done?;
-        fs::rename(&self.tmp, &self.path).map_err(|e| StoreError::io(&self.path, "rename", e))?;
-        self.finished = true;
-        crate::temp::unregister(&self.tmp);
+        let tmp = self.tmp.take().expect("the temp file is kept until finish");
+        tmp.publish(&self.path)
+            .map_err(|e| StoreError::io(&self.path, "rename", e))?;
         // Best effort: makes the rename itself durable; some file systems refuse to sync a
         // directory, and the file is already complete either way.
         if let Some(dir) = self.path.parent() {
@@ -186,15 +177,5 @@ impl StoreWriter {
             }
         }
         Ok(())
-    }
-}
-
-impl Drop for StoreWriter {
-    fn drop(&mut self) {
-        if !self.finished {
-            drop(self.file.take());
-            let _ = fs::remove_file(&self.tmp);
-            crate::temp::unregister(&self.tmp);
-        }
     }
 }

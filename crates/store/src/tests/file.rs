@@ -366,7 +366,7 @@ fn an_unfinished_writer_leaves_nothing_and_a_finished_one_one_file() {
     // Mid-write: only the temp file exists, and it does not read as a photon file.
     let names = dir.listing();
     assert_eq!(names.len(), 1);
-    assert!(names[0].starts_with("map.photons.tmp-"), "{names:?}");
+    assert!(names[0].starts_with(".map.photons.tmp-"), "{names:?}");
     let [e, _] = refused(&dir.path(&names[0]));
     assert!(matches!(e.problem, Problem::NotPhotonFile), "{e}");
     drop(w);
@@ -412,39 +412,23 @@ fn bench_store_reads_back_what_it_wrote() {
     assert!(dir.listing().is_empty());
 }
 
-/// Ctrl-C: the live temp files of this process are removed at once. kill -9: the next run
-/// removes the temp files whose writer is gone, and only those.
+/// A writer's temp file is one of `temps`': a signal handler removes it at once (the sweep of
+/// a dead process's temps is `temps`' own test).
 #[test]
-fn live_temp_files_are_removed_on_request_and_stale_ones_by_pid() {
-    let dir = TempDir::new("stale");
+fn a_writers_temp_file_is_removed_on_a_signal() {
+    let dir = TempDir::new("live");
     let mut w = StoreWriter::with_chunk_capacity(&dir.path("live.photons"), header(), 8).unwrap();
     w.write(&synthetic_photons(0, 20)).unwrap();
-    // A process that has exited: its pid names a dead writer (until the pid is reused).
-    let mut child = std::process::Command::new("true").spawn().unwrap();
-    let dead = child.id();
-    child.wait().unwrap();
-    let stale = format!("old.photons.tmp-{dead}-0");
-    let ours = format!("mine.photons.tmp-{}-999", std::process::id());
-    for f in [&stale, &ours, &"notes.tmp-x-1".to_string()] {
-        std::fs::write(dir.path(f), b"partial").unwrap();
-    }
-    assert_eq!(crate::temp_owner(&stale), Some(dead));
-    assert_eq!(crate::temp_owner("notes.tmp-x-1"), None);
-    let removed = crate::remove_stale_temp_files(&dir.0);
-    assert_eq!(removed, vec![(dir.path(&stale), dead)]);
-    let mut names = dir.listing();
-    names.retain(|n| !n.starts_with("live.photons.tmp-"));
-    assert_eq!(names, [ours.clone(), "notes.tmp-x-1".to_string()]);
-
-    // What the Ctrl-C handler calls, limited to this test's directory: other tests write too.
-    assert_eq!(crate::temp::remove_live_where(|p| p.starts_with(&dir.0)), 1);
-    assert!(
-        !dir.listing()
-            .iter()
-            .any(|n| n.starts_with("live.photons.tmp-")),
-        "{:?}",
-        dir.listing()
+    let names = dir.listing();
+    assert_eq!(names.len(), 1);
+    assert_eq!(
+        temps::owner(&names[0]),
+        Some(std::process::id()),
+        "{names:?}"
     );
+    // What the signal handler calls, limited to this test's directory: other tests write too.
+    assert_eq!(temps::remove_live_under(&dir.0).files, 1);
+    assert!(dir.listing().is_empty(), "{:?}", dir.listing());
     // The writer then fails or is dropped without harm.
     drop(w);
     assert!(crate::free_space(&dir.0).is_some_and(|b| b > 0));
