@@ -466,7 +466,12 @@ pub fn command() -> clap::Command {
         })
         .collect();
     let time_help = format!(
-        "Seconds to render for, a budget to use: the progressive methods' passes go on past the          scene file's count until the time is used, each pass a small share of it (the last          one overshoots by about that). With the run's count given too ({}) the time only          caps it: the run stops at whichever comes first. The output's scene.toml and          image.json record the passes made; methods without passes refuse it",
+        "Seconds to render for, a budget to use: the progressive methods' passes go on \
+         past the scene file's count until the time is used, and the last one overshoots it \
+         by about one pass (the path tracer's passes are sized to 1/32 of the budget). With \
+         the run's count given too ({}) the time only caps it: the run stops at whichever \
+         comes first. The output's scene.toml and image.json record the passes made; \
+         methods without passes refuse it",
         counts.join("; ")
     );
     Cli::command()
