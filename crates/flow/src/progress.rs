@@ -38,6 +38,25 @@ impl Progress {
         }
     }
 
+    /// Work of no known total (a time budget ends it): on a terminal the count and its rate,
+    /// on a pipe nothing (the work reports per pass on its own lines).
+    pub fn unbounded(label: &str, unit: &'static str) -> Progress {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let b = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+            b.set_style(
+                ProgressStyle::with_template(&format!(
+                    "{label} {{spinner}} {{human_pos}} {unit} [{{per_sec}}, {{elapsed}} elapsed]"
+                ))
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+            );
+            b
+        });
+        Progress {
+            bar,
+            ..Progress::hidden()
+        }
+    }
+
     /// No output at all (benchmarks time the work, not the printing).
     pub fn hidden() -> Progress {
         Progress {

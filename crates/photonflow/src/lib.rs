@@ -328,8 +328,8 @@ struct PhotonArgs {
     /// scene's estimate.splat.passes, 1).
     #[arg(long)]
     passes: Option<u32>,
-    /// Stop the progressive methods' passes after this many seconds (at least one pass runs);
-    /// the output's scene.toml records the passes made.
+    /// Seconds for the progressive methods' passes (the full help is drawn from the method
+    /// table in `command`).
     #[arg(long)]
     time: Option<f64>,
     /// Compare with this linear EXR (the path-traced reference) and record the error.
@@ -452,16 +452,40 @@ pub fn command() -> clap::Command {
         "Passes of the progressive methods (a run stopped by --time records those made)",
         |r| r.passes,
     );
+    // Which flags give the count that --time then only caps, per progressive method.
+    let counts: Vec<String> = render::methods::METHODS
+        .iter()
+        .filter(|r| r.passes.is_some())
+        .map(|r| {
+            let flags: Vec<&str> = [("--spp", r.spp), ("--passes", r.passes)]
+                .into_iter()
+                .filter(|(_, k)| k.is_some_and(Knob::counts_passes))
+                .map(|(f, _)| f)
+                .collect();
+            format!("{}: {}", r.method, flags.join(" or "))
+        })
+        .collect();
+    let time_help = format!(
+        "Seconds to render for, a budget to use: the progressive methods' passes go on \
+         past the scene file's count until the time is used, and the last one overshoots it \
+         by about one pass (the path tracer's passes are sized to 1/32 of the budget). With \
+         the run's count given too ({}) the time only caps it: the run stops at whichever \
+         comes first. The output's scene.toml and image.json record the passes made; \
+         methods without passes refuse it",
+        counts.join("; ")
+    );
     Cli::command()
         .mut_subcommand("render", |c| {
             c.mut_arg("method", |a| a.help(render_help))
                 .mut_arg("spp", |a| a.help(spp_help.clone()))
                 .mut_arg("passes", |a| a.help(passes_help.clone()))
+                .mut_arg("time", |a| a.help(time_help.clone()))
         })
         .mut_subcommand("estimate", |c| {
             c.mut_arg("method", |a| a.help(estimate_help))
                 .mut_arg("spp", |a| a.help(spp_help.clone()))
                 .mut_arg("passes", |a| a.help(passes_help.clone()))
+                .mut_arg("time", |a| a.help(time_help.clone()))
         })
 }
 

@@ -960,3 +960,54 @@ fn interrupted_shards_leave_no_staging_directories() {
         "{e}"
     );
 }
+
+/// `--time` alone is a budget to use: the passes go on past the scene file's count (here 1)
+/// until the time is used, and `image.json`, the snapshots and `scene.toml` record the passes
+/// made; with `--passes` too the time only caps them. Nothing here asserts a duration.
+#[test]
+fn time_is_a_budget_to_use_and_with_passes_a_cap() {
+    let scene = format!("{}[estimate.sppm]\npasses = 1\n", toml());
+    let dir = Scratch::new(
+        "time",
+        &[("s.toml", &scene), ("a.obj", OBJ), ("m.mtl", MTL)],
+    );
+    let s = dir.0.join("s.toml");
+    let render = |name: &str, extra: &[&str]| {
+        let out = dir.0.join(name);
+        let mut args = vec![
+            "render",
+            s.to_str().unwrap(),
+            "--method",
+            "sppm",
+            "--photons",
+            "200",
+            "--out",
+            out.to_str().unwrap(),
+            "--cache",
+            dir.0.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = photonflow(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let json = std::fs::read_to_string(out.join("image.json")).unwrap();
+        let json: serde_json::Value = serde_json::from_str(&json).unwrap();
+        let toml = std::fs::read_to_string(out.join("scene.toml")).unwrap();
+        (json, toml)
+    };
+    // 0.5 s of passes of 200 photon paths on an 8x8 image: many more than the file's one.
+    let (json, toml) = render("budget", &["--time", "0.5"]);
+    assert_eq!(json["time_budget"]["stopped_by"], "time", "{json}");
+    assert_eq!(json["time_budget"]["capped"], false);
+    let made = json["sppm_passes"].as_u64().unwrap();
+    assert!(made > 1, "{made} passes");
+    assert_eq!(json["sppm"]["passes"], made);
+    assert!(toml.contains(&format!("passes = {made}\n")), "{toml}");
+    let snaps = json["snapshots"].as_array().unwrap();
+    assert_eq!(snaps.last().unwrap()["passes"], made);
+    // With --passes the time is a cap, and the count comes first.
+    let (json, toml) = render("capped", &["--time", "1000", "--passes", "3"]);
+    assert_eq!(json["time_budget"]["stopped_by"], "count", "{json}");
+    assert_eq!(json["time_budget"]["capped"], true);
+    assert_eq!(json["sppm_passes"], 3);
+    assert!(toml.contains("passes = 3\n"), "{toml}");
+}

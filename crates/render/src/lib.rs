@@ -92,8 +92,14 @@ pub fn render(scene: &Scene, req: &RenderRequest) -> Result<RenderSummary, Strin
     let bar = std::sync::OnceLock::new();
     let (work, unit) = methods::work(&run);
     let name = settings.method.name();
+    // A time budget alone ends the passes, not a count a bar could fill.
+    let open = settings.time.is_some_and(|b| !b.capped);
     let rendered = methods::render(&run, &|n| {
-        bar.get_or_init(|| Progress::new(&name, work, unit)).inc(n)
+        bar.get_or_init(|| match open {
+            true => Progress::unbounded(&name, unit),
+            false => Progress::new(&name, work, unit),
+        })
+        .inc(n)
     })?;
     if let Some(p) = bar.into_inner() {
         p.finish();

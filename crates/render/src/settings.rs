@@ -181,17 +181,28 @@ pub struct Overrides {
     /// Whether splatted caustic paths go on past their first diffuse hit
     /// (`[estimate.splat] indirect`).
     pub splat_indirect: Option<bool>,
-    /// Stop the progressive methods' passes once this many seconds have passed (after at
-    /// least one); not a setting of the scene file, which records the passes made instead.
+    /// Seconds for the progressive methods' passes ([`Budget`]); not a setting of the scene
+    /// file, which records the passes made instead.
     pub time: Option<f64>,
+}
+
+/// `--time`: a budget of seconds for the progressive passes, which run until it is used (at
+/// least one pass runs; the last one ends past it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Budget {
+    pub seconds: f64,
+    /// The run's count was given too (`--passes`, or the path tracer's `--spp`): the time
+    /// only caps it, and the run stops at whichever comes first. Otherwise the passes go on
+    /// past the scene file's count, which is only a default, until the time is used.
+    pub capped: bool,
 }
 
 /// Everything a run needs besides the scene's geometry.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
     pub method: Method,
-    /// Time budget of the progressive passes (see [`Overrides::time`]).
-    pub time: Option<f64>,
+    /// Time budget of the progressive passes.
+    pub time: Option<Budget>,
     /// `[render]`, with `spp` and `caustics` overridden for the path tracer.
     pub render: scene::RenderSettings,
     pub emit: EmitParams,
@@ -226,12 +237,27 @@ impl Knob {
     /// The problem with `v` as this setting's value, if any (the caller names the file's key
     /// or the flag): the same bounds for both.
     pub fn check(self, v: u32) -> Result<(), String> {
+        count_in(v.into(), self.max().into(), &self.max().to_string())
+    }
+
+    /// The largest value the setting takes: where a run that a time budget alone ends must
+    /// stop, so the scene file recording its count stays valid.
+    pub const fn max(self) -> u32 {
         match self {
-            Knob::RenderSpp => count_in(v.into(), 1 << 24, "16777216"),
-            Knob::EstimateSpp | Knob::SplatPasses | Knob::SppmPasses => {
-                count_in(v.into(), 1 << 20, "1048576")
-            }
+            Knob::RenderSpp => 1 << 24,
+            Knob::EstimateSpp | Knob::SplatPasses | Knob::SppmPasses => 1 << 20,
         }
+    }
+
+    /// `key = max`, for messages.
+    pub fn at_max(self) -> String {
+        format!("{} = {}", self.key(), self.max())
+    }
+
+    /// It counts a progressive run's passes (the path tracer's samples are its passes'
+    /// unit): given as a flag with `--time`, the time only caps that count.
+    pub const fn counts_passes(self) -> bool {
+        !matches!(self, Knob::EstimateSpp)
     }
 
     pub fn get(self, s: &Settings) -> u32 {
@@ -335,9 +361,14 @@ impl Settings {
                  progressive methods take it)"
             ));
         }
+        // The count is the flags' only when it is one the progressive loop counts (not
+        // caustic-splat's `--spp`, its eye vertices per pixel and pass).
+        let capped = [(o.spp, flags.spp), (o.passes, flags.passes)]
+            .iter()
+            .any(|(v, k)| v.is_some() && k.is_some_and(Knob::counts_passes));
         let mut s = Settings {
             method,
-            time: o.time,
+            time: o.time.map(|seconds| Budget { seconds, capped }),
             render,
             emit,
             estimate,

@@ -5,6 +5,7 @@
 
 use crate::rendered::{CountKind, Layer, Rendered};
 use crate::run::Run;
+use crate::settings::{Knob, SplatSettings};
 use crate::splat;
 use film::Class;
 
@@ -107,12 +108,17 @@ impl<'a> Progressive<'a> {
             }
         }
         self.passes += 1;
-        let sp = &self.run.settings.estimate.splat;
-        if sp.passes > 1 {
+        let s = self.run.settings;
+        let open = s.time.is_some_and(|b| !b.capped);
+        if s.estimate.splat.passes > 1 || open {
+            // A time budget alone has no count to show.
+            let of = match open {
+                true => String::new(),
+                false => format!("/{}", s.estimate.splat.passes),
+            };
             eprintln!(
-                "splat pass {}/{}: {:.2} s, {:.3} M photons/s",
+                "splat pass {}{of}: {:.2} s, {:.3} M photons/s",
                 self.passes,
-                sp.passes,
                 self.t_splat,
                 (self.passes as u64 * self.params.photons) as f64 / self.t_splat / 1e6
             );
@@ -148,7 +154,14 @@ impl<'a> Progressive<'a> {
         let (scene, sp) = (self.run.scene, &self.run.settings.estimate.splat);
         let mut info = serde_json::Map::new();
         for (k, v) in [
-            ("splat", serde_json::json!(sp)),
+            // The settings of the run made: a time budget sets the passes.
+            (
+                "splat",
+                serde_json::json!(SplatSettings {
+                    passes: self.passes,
+                    ..*sp
+                }),
+            ),
             ("splat_photons_emitted", self.params.photons.into()),
             ("eye_vertices", self.vertices.into()),
             (
@@ -222,7 +235,16 @@ impl crate::passes::Progressive for Progressive<'_> {
         self.run.settings.estimate.splat.passes
     }
 
-    fn step(&mut self, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
+    fn limit(&self) -> (u32, String) {
+        (Knob::SplatPasses.max(), Knob::SplatPasses.at_max())
+    }
+
+    /// One photon pass, whatever `_pass` allows: passes are the unit of the mean.
+    fn step(
+        &mut self,
+        _pass: crate::passes::Pass,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<(), String> {
         Progressive::step(self, progress)
     }
 

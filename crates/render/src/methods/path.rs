@@ -5,11 +5,16 @@
 //! Progressive (`crate::passes`): the samples are rendered in passes of 1, 1, 2, 4, ...
 //! samples per pixel, at most an eighth of the run each (so a pass never takes more than the
 //! time already spent, or an eighth of the run; passes cost a film each, so there are few of
-//! them), pixel sample `s` drawing what it would in one run of all of them; a time budget
-//! stops after the pass that reaches it and records the samples made.
+//! them), pixel sample `s` drawing what it would in one run of all of them. Under a time
+//! budget a pass also holds at most the samples a small share of the budget makes at the
+//! rate so far (`passes::BUDGET_SHARE`): the doubling stops there and equal passes follow.
+//! Every pass is a power of two no larger than the largest one dividing the samples made, so
+//! every power of two of samples still ends a pass (and has its snapshot). The run records
+//! the samples made.
 
 use crate::rendered::{CountKind, Layer, Rendered};
 use crate::run::Run;
+use crate::settings::Knob;
 use film::Class;
 use glam::DVec3;
 
@@ -63,9 +68,9 @@ impl<'a> Progressive<'a> {
         self.blocks
     }
 
-    /// Samples of the next pass of a run of `spp` (see [`next_pass`]).
-    pub(super) fn next_pass(&self, spp: u32) -> u32 {
-        next_pass(self.samples, spp)
+    /// Samples of the next pass within `pass` (see [`next_pass`]).
+    pub(super) fn next_pass(&self, pass: crate::passes::Pass) -> u32 {
+        next_pass(self.samples, pass.end, pass.at_most)
     }
 
     /// The layers' names, in the order [`Progressive::block`] returns their sums.
@@ -172,12 +177,20 @@ impl<'a> Progressive<'a> {
     }
 }
 
-/// Samples of the pass after `samples` of a run of `spp`: as many as made so far (at least
-/// one), at most `spp / MIN_PASSES` rounded up to a power of two, so every power of two of
-/// samples ends a pass.
-fn next_pass(samples: u32, spp: u32) -> u32 {
-    let cap = spp.div_ceil(MIN_PASSES).max(1).next_power_of_two();
-    samples.clamp(1, cap).min(spp - samples)
+/// Samples of the pass after `samples` of a run to `end`: as many as made so far (at least
+/// one), at most `end / MIN_PASSES` rounded up to a power of two and `at_most` rounded down
+/// to one, and no more than are left. Every pass but a last remainder is a power of two no
+/// larger than the largest one dividing `samples`, so every power of two of samples ends a
+/// pass; with `at_most` unbounded these are the passes 1, 1, 2, 4, ... up to the cap.
+fn next_pass(samples: u32, end: u32, at_most: u32) -> u32 {
+    let cap = end.div_ceil(MIN_PASSES).max(1).next_power_of_two();
+    let aligned = if samples == 0 {
+        1
+    } else {
+        1 << samples.trailing_zeros()
+    };
+    let budget = 1 << at_most.max(1).ilog2();
+    aligned.min(cap).min(budget).min(end - samples)
 }
 
 /// The sample ranges of a run of `spp`'s passes, in order: the blocks shards split and a
@@ -186,7 +199,7 @@ pub(super) fn passes(spp: u32) -> Vec<std::ops::Range<u64>> {
     let mut out = Vec::new();
     let mut done = 0;
     while done < spp {
-        let n = next_pass(done, spp);
+        let n = next_pass(done, spp, u32::MAX);
         out.push(done as u64..(done + n) as u64);
         done += n;
     }
@@ -236,8 +249,16 @@ impl crate::passes::Progressive for Progressive<'_> {
         self.run.settings.render.spp
     }
 
-    fn step(&mut self, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
-        Progressive::step(self, self.next_pass(self.total()), progress)
+    fn limit(&self) -> (u32, String) {
+        (Knob::RenderSpp.max(), Knob::RenderSpp.at_max())
+    }
+
+    fn step(
+        &mut self,
+        pass: crate::passes::Pass,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<(), String> {
+        Progressive::step(self, self.next_pass(pass), progress)
     }
 
     fn layers(&self) -> Vec<Layer> {
@@ -251,4 +272,53 @@ impl crate::passes::Progressive for Progressive<'_> {
 
 pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
     crate::passes::run(&mut Progressive::new(run), run.settings.time, progress)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The passes before time budgets sized them: `passes` (what shards split) and every
+    /// run without `--time` must keep them, or images change.
+    fn old_passes(spp: u32) -> Vec<u32> {
+        let cap = spp.div_ceil(MIN_PASSES).max(1).next_power_of_two();
+        let (mut out, mut done) = (Vec::new(), 0);
+        while done < spp {
+            let n = done.clamp(1, cap).min(spp - done);
+            out.push(n);
+            done += n;
+        }
+        out
+    }
+
+    #[test]
+    fn passes_without_a_budget_are_unchanged() {
+        for spp in (1..=600).chain([1000, 4096, 4097, 65535, 1 << 24]) {
+            let new: Vec<u32> = passes(spp)
+                .iter()
+                .map(|r| (r.end - r.start) as u32)
+                .collect();
+            assert_eq!(new, old_passes(spp), "spp {spp}");
+        }
+    }
+
+    #[test]
+    fn budget_sized_passes_end_at_every_power_of_two() {
+        // A budget allowing 5, then 40, then 3 samples a pass, in a run to render.spp's
+        // bound: passes are powers of two within it, and every power of two of samples ends
+        // one.
+        let end = Knob::RenderSpp.max();
+        let mut done = 0;
+        let mut ends = Vec::new();
+        for at_most in [5; 6].into_iter().chain([40; 8]).chain([3; 8]) {
+            let n = next_pass(done, end, at_most);
+            assert!(n.is_power_of_two() && n <= at_most, "{n} at {done}");
+            done += n;
+            ends.push(done);
+        }
+        assert_eq!(ends[..6], [1, 2, 4, 8, 12, 16]);
+        for p in (0..).map(|i| 1u32 << i).take_while(|&p| p <= done) {
+            assert!(ends.contains(&p), "{p} samples end no pass: {ends:?}");
+        }
+    }
 }

@@ -11,8 +11,10 @@
 //! far along.
 
 use super::{caustic_splat, path};
+use crate::passes::Pass;
 use crate::rendered::{Layer, Rendered};
 use crate::run::Run;
+use crate::settings::Knob;
 
 struct PathSplat<'a> {
     image: path::Progressive<'a>,
@@ -30,10 +32,23 @@ impl crate::passes::Progressive for PathSplat<'_> {
         self.spp
     }
 
-    fn step(&mut self, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
-        self.image.step(self.image.next_pass(self.spp), progress)?;
-        // Splatting keeps pace with the path tracer's share of samples made. Its progress
-        // counts photons, not samples: it reports through its own line.
+    fn limit(&self) -> (u32, String) {
+        // Splatting's passes keep their ratio to the samples past the settings' counts: the
+        // samples stop where either reaches its bound.
+        let by_splat = Knob::SplatPasses.max() as u64 * self.spp as u64 / self.splat_passes as u64;
+        let spp = Knob::RenderSpp;
+        if spp.max() as u64 <= by_splat {
+            (spp.max(), spp.at_max())
+        } else {
+            (by_splat as u32, Knob::SplatPasses.at_max())
+        }
+    }
+
+    fn step(&mut self, pass: Pass, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
+        self.image.step(self.image.next_pass(pass), progress)?;
+        // Splatting keeps pace with the path tracer's share of samples made (of the settings'
+        // counts, so a time budget keeps their ratio). Its progress counts photons, not
+        // samples: it reports through its own line.
         let due = (self.splat_passes as u64 * self.image.samples as u64)
             .div_ceil(self.spp as u64)
             .max(1) as u32;

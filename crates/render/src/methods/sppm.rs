@@ -20,9 +20,10 @@
 //! §7.2), as `[estimate.sppm] boundary` asks by default.
 
 use crate::boundary::{MIN_MASS, kernel_mass_on_surface};
+use crate::passes::Pass;
 use crate::rendered::{CountKind, Layer, Rendered};
 use crate::run::Run;
-use crate::settings::{SPPM_BOUNDARY_TOPO, SppmSettings};
+use crate::settings::{Knob, SPPM_BOUNDARY_TOPO, SppmSettings};
 use density::sppm::PixelStats;
 use density::{IndexKind, PhotonMap};
 use emit::{EmitParams, Plan};
@@ -165,7 +166,13 @@ impl crate::passes::Progressive for Sppm<'_> {
         self.run.settings.estimate.sppm.passes
     }
 
-    fn step(&mut self, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
+    fn limit(&self) -> (u32, String) {
+        (Knob::SppmPasses.max(), Knob::SppmPasses.at_max())
+    }
+
+    /// One photon pass, whatever `_pass` allows: its size is the photons per pass, which the
+    /// statistics' update assumes.
+    fn step(&mut self, _pass: Pass, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
         let (run, scene, s) = (self.run, self.run.scene, self.run.settings);
         let sp = &s.estimate.sppm;
         let pass = self.passes as u64;
@@ -201,12 +208,18 @@ impl crate::passes::Progressive for Sppm<'_> {
         let passes = self.passes;
         progress(self.stats.len() as u64);
         let elapsed = self.t0.elapsed().as_secs_f64();
-        // Passes left: to the count, or to the time budget if that comes first.
-        let left = (sp.passes - passes) as f64 * elapsed / passes as f64;
-        let left = s.time.map_or(left, |t| left.min((t - elapsed).max(0.0)));
+        // Time left: to the count, or to the time budget if that comes first; a budget alone
+        // has no count to show.
+        let by_count = sp.passes.saturating_sub(passes) as f64 * elapsed / passes as f64;
+        let (of, left) = match s.time {
+            Some(b) if !b.capped => (String::new(), (b.seconds - elapsed).max(0.0)),
+            b => (
+                format!("/{}", sp.passes),
+                b.map_or(by_count, |b| by_count.min((b.seconds - elapsed).max(0.0))),
+            ),
+        };
         eprintln!(
-            "sppm pass {passes}/{}: {elapsed:.2} s, {:.3} M photon paths/s, about {left:.1} s left",
-            sp.passes,
+            "sppm pass {passes}{of}: {elapsed:.2} s, {:.3} M photon paths/s, about {left:.1} s left",
             (passes as u64 * self.params.photons) as f64 / elapsed / 1e6
         );
         Ok(())
@@ -231,7 +244,8 @@ impl crate::passes::Progressive for Sppm<'_> {
         let stats = &self.stats;
         let r_mean = stats.iter().map(|st| st.r as f64).sum::<f64>() / stats.len().max(1) as f64;
         for (k, v) in [
-            ("sppm", serde_json::json!(sp)),
+            // The settings of the run made: a time budget sets the passes.
+            ("sppm", serde_json::json!(SppmSettings { passes, ..*sp })),
             ("sppm_passes", passes.into()),
             ("sppm_start_radius", self.r0.into()),
             ("sppm_mean_final_radius", r_mean.into()),
