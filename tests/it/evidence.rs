@@ -3,7 +3,7 @@
 
 use crate::kit::{TempDir, worksheet, write_worksheet};
 use film::Image;
-use lab::evidence::{Budget, Technique, render_image, rung};
+use lab::evidence::{Budget, Technique, Traces, render_image, rung};
 use lab::regions::regions;
 use render::Overrides;
 use scene::{Method, Scene};
@@ -30,8 +30,8 @@ fn reference(cache: &Path) -> Image {
 #[test]
 fn bias_is_zero_for_the_path_tracer_and_grows_with_k_at_the_caustic() {
     let dir = TempDir::new("evidence");
-    let cache = dir.path().join("cache");
-    let reference = reference(&cache);
+    let traces = Traces::new(dir.path().join("cache"));
+    let reference = reference(traces.dir());
     let scene = worksheet(RES, 1);
     let regions = regions(&scene);
     let region = |r: &lab::evidence::RungResult, name: &str| {
@@ -53,7 +53,7 @@ fn bias_is_zero_for_the_path_tracer_and_grows_with_k_at_the_caustic() {
         layer: None,
     };
     let r = rung(
-        &at_seed, &path, 64, seeds, &reference, &regions, &cache, None,
+        &at_seed, &path, 64, seeds, &reference, &regions, &traces, None,
     )
     .unwrap_or_else(|e| panic!("{e}"));
     let (e, s) = region(&r, "image");
@@ -83,7 +83,7 @@ fn bias_is_zero_for_the_path_tracer_and_grows_with_k_at_the_caustic() {
             4,
             &reference,
             &regions,
-            &cache,
+            &traces,
             None,
         )
         .unwrap_or_else(|e| panic!("{e}"));

@@ -31,7 +31,9 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
                       reference: relMSE (two conventions), RMSE, mean ratio, FLIP, bias^2 and
                       variance per region (caustic, edges and corners, outer rim, glass sphere,
                       open walls), the k sweep; the lab report out/evidence/report.html and
-                      report.md with images, crops, maps and SVG plots; evidence.md, evidence.json
+                      report.md with images, crops, maps and SVG plots; evidence.md, evidence.json;
+                      --quick: about 2 minutes, at most 256 pixels on a side, 4 seeds, a 512-spp
+                      reference, two budgets per technique, k in {50, 250, 1000}
   composite RUN... --out DIR
                       combine runs of one view: layers of one name averaged by their counts,
                       disjoint layers summed (independent runs: other --seed)

@@ -10,8 +10,10 @@ use density::Kernel;
 use film::{BiasVariance, Image, Mask};
 use render::{Overrides, Settings};
 use render::{Photons, Rendered, Run};
-use scene::{Method, Scene};
+use scene::{Method, Scene, SceneFile};
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::time::Instant;
 
 pub struct EvidenceArgs {
@@ -23,7 +25,8 @@ pub struct EvidenceArgs {
     pub reference_spp: u32,
     /// Independent runs per method and budget.
     pub seeds: u32,
-    /// The short ladder (minutes on 2 cores).
+    /// The short ladders on an image at most [`QUICK_SIDE`] pixels on a side (unless
+    /// `reference` fixes its size): minutes on 2 cores.
     pub quick: bool,
     /// Every budget (and the k sweep's photon count) times this, at least 1.
     pub budget_scale: f64,
@@ -99,14 +102,14 @@ pub fn techniques(quick: bool) -> Vec<Technique> {
             overrides: m(Method::Path),
             budget: Budget::Spp,
             layer: None,
-            ladder: ladder(&[4, 16], &[16, 64, 128]),
+            ladder: ladder(&[2, 8], &[16, 64, 128]),
         },
         Technique {
             name: "path+splat",
             overrides: m(Method::PathSplat),
             budget: Budget::Spp,
             layer: None,
-            ladder: ladder(&[4, 16], &[4, 16, 64]),
+            ladder: ladder(&[2, 8], &[4, 16, 64]),
         },
         Technique {
             name: "global map, box",
@@ -148,7 +151,7 @@ pub fn techniques(quick: bool) -> Vec<Technique> {
             overrides: m(Method::Sppm),
             budget: Budget::Passes,
             layer: None,
-            ladder: ladder(&[4, 16], &[4, 16, 64]),
+            ladder: ladder(&[2, 8], &[4, 16, 64]),
         },
         // The caustic map as the course's final gathering makes it (k = 250, every path of
         // the trace paid for, the global set's included, and direct light; one gather ray
@@ -165,7 +168,7 @@ pub fn techniques(quick: bool) -> Vec<Technique> {
             },
             budget: Budget::Photons,
             layer: Some("caustic"),
-            ladder: ladder(&[200_000, 1_000_000], &[200_000, 1_000_000, 4_000_000]),
+            ladder: ladder(&[100_000, 400_000], &[200_000, 1_000_000, 4_000_000]),
         },
         Technique {
             name: "caustic splat (differentials)",
@@ -176,7 +179,7 @@ pub fn techniques(quick: bool) -> Vec<Technique> {
             },
             budget: Budget::SplatPhotons,
             layer: Some("caustic"),
-            ladder: ladder(&[250_000, 1_000_000], &[250_000, 1_000_000, 4_000_000]),
+            ladder: ladder(&[100_000, 400_000], &[250_000, 1_000_000, 4_000_000]),
         },
     ]
 }
@@ -205,6 +208,7 @@ pub struct RegionResult {
 }
 
 /// One rung's result: its mean time, its regions, the maps and the first run's image.
+#[derive(Clone)]
 pub struct RungResult {
     pub technique: &'static str,
     pub budget: Budget,
@@ -242,6 +246,56 @@ pub fn render_image(
     Ok((img, r))
 }
 
+/// The photon sets of one evidence run, in one directory kept until the run ends: every rung
+/// reading the sets of one seed and photon count (the global map's kernels and tests, the k
+/// sweep, the caustic map) traces them once. Tracing is deterministic in the seed and the
+/// parameters, so a reused set is the one a new trace would make; each run reusing it is
+/// charged the seconds its tracing took, so times still count the tracing.
+pub struct Traces {
+    dir: PathBuf,
+    /// Trace seconds per set (its cache file name).
+    seconds: Mutex<HashMap<PathBuf, f64>>,
+}
+
+impl Traces {
+    /// Empties `dir` first: a set left there by another run has no trace time to charge.
+    pub fn new(dir: PathBuf) -> Traces {
+        let _ = std::fs::remove_dir_all(&dir);
+        Traces {
+            dir,
+            seconds: Mutex::new(HashMap::new()),
+        }
+    }
+
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// The trace seconds to charge a run of `scene` with `o` that made `r`: none when it
+    /// traced (its time holds them), the first trace's when it reused the sets.
+    fn charge(&self, scene: &Scene, o: &Overrides, r: &Rendered) -> Result<f64, String> {
+        let Some(trace) = r.info.get("trace") else {
+            return Ok(0.0);
+        };
+        let key = photons::CacheKey::new(scene, &Settings::new(scene, o)?.emit)
+            .file(&self.dir, store::MapKind::Global);
+        let mut seconds = self.seconds.lock().unwrap_or_else(|e| e.into_inner());
+        if trace == "traced" {
+            let s = r.info.get("time_trace_s").and_then(|v| v.as_f64());
+            seconds.insert(key, s.unwrap_or(0.0));
+            Ok(0.0)
+        } else {
+            Ok(seconds.get(&key).copied().unwrap_or(0.0))
+        }
+    }
+}
+
+impl Drop for Traces {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
 /// Renders one rung with seeds `1..=seeds` (`scene(seed)` makes the scene of each) and
 /// decomposes its error against `reference` (the reference's layer `t.layer`, for a
 /// technique that compares one layer).
@@ -253,7 +307,7 @@ pub fn rung<'a>(
     seeds: u32,
     reference: impl Into<Against<'a>>,
     regions: &[(&'static str, Mask)],
-    cache: &Path,
+    traces: &Traces,
     threads: Option<usize>,
 ) -> Result<RungResult, String> {
     let Against {
@@ -265,11 +319,9 @@ pub fn rung<'a>(
     let mut seconds = 0.0;
     for seed in 1..=seeds as u64 {
         let scene = scene(seed)?;
-        // Each run traces its own photons: the seed changes them, and the time counts them.
-        let _ = std::fs::remove_dir_all(cache);
         let t0 = Instant::now();
-        let (img, r) = render_image(&scene, &o, cache, threads)?;
-        seconds += t0.elapsed().as_secs_f64();
+        let (img, r) = render_image(&scene, &o, traces.dir(), threads)?;
+        seconds += t0.elapsed().as_secs_f64() + traces.charge(&scene, &o, &r)?;
         let img = match t.layer {
             None => img,
             Some(name) => {
@@ -282,7 +334,6 @@ pub fn rung<'a>(
         };
         images.push(img);
     }
-    let _ = std::fs::remove_dir_all(cache);
     let runs: Vec<&Image> = images.iter().collect();
     let maps = match halves {
         Some(h) => BiasVariance::against_halves(&runs, h, true),
@@ -416,6 +467,8 @@ pub struct Evidence {
     pub sweep_photons: u64,
     /// Why a technique was left out (no reference layer to compare with, say).
     pub skipped: Vec<String>,
+    /// What `--quick` traded away, when it was given.
+    pub quick: Option<String>,
 }
 
 /// One point of the k sweep.
@@ -460,7 +513,14 @@ pub fn run(a: &EvidenceArgs) -> Result<Measured, String> {
         ));
     }
     let scale = |n: u64| ((n as f64 * a.budget_scale).round() as u64).max(1);
-    let scene = Scene::load(&a.scene).map_err(|e| e.to_string())?;
+    // `--quick` renders fewer pixels, unless a given reference fixes the image's size.
+    let shrink = a.quick && a.reference.is_none();
+    let edit = |f: &mut SceneFile| {
+        if shrink {
+            (f.camera.width, f.camera.height) = quick_size(f.camera.width, f.camera.height);
+        }
+    };
+    let scene = Scene::load_with(&a.scene, edit).map_err(|e| e.to_string())?;
     // Nothing is written before the reference is known to be usable (a given one is read
     // and checked first; a cached one is rendered into `out`, which it creates).
     let reference = reference(&scene, a)?;
@@ -470,8 +530,14 @@ pub fn run(a: &EvidenceArgs) -> Result<Measured, String> {
         .filter(|(n, _)| matches!(*n, "image" | "caustic"))
         .cloned()
         .collect();
-    let cache = a.out.join("cache");
-    let make = |seed: u64| Scene::load_with(&a.scene, |f| f.seed = seed).map_err(|e| e.to_string());
+    let traces = Traces::new(a.out.join("cache"));
+    let make = |seed: u64| {
+        Scene::load_with(&a.scene, |f| {
+            f.seed = seed;
+            edit(f);
+        })
+        .map_err(|e| e.to_string())
+    };
     let mut ev = Evidence {
         scene: a.scene.clone(),
         seeds: a.seeds,
@@ -484,7 +550,29 @@ pub fn run(a: &EvidenceArgs) -> Result<Measured, String> {
         sweep: Vec::new(),
         sweep_photons: scale(200_000),
         skipped: Vec::new(),
+        quick: a.quick.then(|| {
+            format!(
+                "`--quick`: {} x {} pixels{}, {} seeds, a {}, two budgets per technique (one \
+                 for final gathering) and k in {{50, 250, 1000}}: a few minutes in place of \
+                 about 45, at the price of noisier bias^2 and variance figures and errors \
+                 nearer the reference's own noise.",
+                scene.camera.width,
+                scene.camera.height,
+                if shrink {
+                    " (the scene's view, fewer pixels)"
+                } else {
+                    ""
+                },
+                a.seeds,
+                a.reference
+                    .as_ref()
+                    .map_or(format!("{}-spp reference", a.reference_spp), |_| {
+                        "given reference".to_string()
+                    }),
+            )
+        }),
     };
+    let mut done = Done::default();
     let wanted = |name: &str| a.only.is_empty() || a.only.iter().any(|o| slug(o) == slug(name));
     for mut t in techniques(a.quick).into_iter().filter(|t| wanted(t.name)) {
         t.ladder = t.ladder.iter().map(|&n| scale(n)).collect();
@@ -511,8 +599,10 @@ pub fn run(a: &EvidenceArgs) -> Result<Measured, String> {
         };
         for &amount in &t.ladder {
             let r = rung(
-                &make, &t, amount, a.seeds, against, regions, &cache, a.threads,
+                &make, &t, amount, a.seeds, against, regions, &traces, a.threads,
             )?;
+            let key = done.key(&make, &t, amount, a.seeds, against.halves.is_some())?;
+            done.0.insert(key, Ran::Rung(ev.rungs.len()));
             let e = &r.regions[0].errors;
             println!(
                 "{:<64} {:>22} {:8.2} s  relMSE {:.5}{}  FLIP {:.4}",
@@ -528,13 +618,76 @@ pub fn run(a: &EvidenceArgs) -> Result<Measured, String> {
         }
     }
     if wanted("k-sweep") {
-        k_sweep(a, &make, &reference.image, &regions, &cache, &mut ev)?;
+        k_sweep(
+            a,
+            &make,
+            &reference.image,
+            &regions,
+            &traces,
+            &mut done,
+            &mut ev,
+        )?;
     }
     Ok(Measured {
         evidence: ev,
         scene,
         regions,
     })
+}
+
+/// The longer side of `--quick`'s image: a quarter of the worksheet's 512 x 512 pixels.
+pub const QUICK_SIDE: u32 = 256;
+/// Seeds and reference samples per pixel where the flags do not set them, without and with
+/// `--quick`.
+pub const SEEDS: u32 = 8;
+pub const REFERENCE_SPP: u32 = 1024;
+pub const QUICK_SEEDS: u32 = 4;
+pub const QUICK_REFERENCE_SPP: u32 = 512;
+
+/// `width` x `height` scaled so the longer side is at most [`QUICK_SIDE`] (the same view).
+pub fn quick_size(width: u32, height: u32) -> (u32, u32) {
+    let long = width.max(height) as u64;
+    if long <= QUICK_SIDE as u64 {
+        return (width, height);
+    }
+    let side = |n: u32| ((n as u64 * QUICK_SIDE as u64 + long / 2) / long).max(1) as u32;
+    (side(width), side(height))
+}
+
+/// Where an earlier rung's result is.
+#[derive(Clone, Copy)]
+enum Ran {
+    Rung(usize),
+    Sweep(usize),
+}
+
+/// The rungs measured so far by what they render: a rung with equal settings (for seed 1),
+/// seeds, layer and reference renders the same images bit for bit (every random stream
+/// follows the seed), so it is taken, not rendered again (the k sweep's points at the
+/// global map's own k and photon count).
+#[derive(Default)]
+struct Done(HashMap<String, Ran>);
+
+impl Done {
+    fn key(
+        &self,
+        make: &dyn Fn(u64) -> Result<Scene, String>,
+        t: &Technique,
+        amount: u64,
+        seeds: u32,
+        halves: bool,
+    ) -> Result<String, String> {
+        let scene = make(1)?;
+        let hash = Settings::new(&scene, &t.budget.apply(&t.overrides, amount))?.hash(&scene);
+        Ok(format!("{hash:016x} {:?} {seeds} {halves}", t.layer))
+    }
+
+    fn get<'e>(&self, key: &str, ev: &'e Evidence) -> Option<&'e RungResult> {
+        match *self.0.get(key)? {
+            Ran::Rung(i) => ev.rungs.get(i),
+            Ran::Sweep(i) => ev.sweep.get(i).map(|s| &s.rung),
+        }
+    }
 }
 
 /// What [`run`] measured, for the report: the evidence, the scene it was measured on and the
@@ -554,7 +707,8 @@ fn k_sweep(
     make: &dyn Fn(u64) -> Result<Scene, String>,
     reference: &Image,
     regions: &[(&'static str, Mask)],
-    cache: &Path,
+    traces: &Traces,
+    done: &mut Done,
     ev: &mut Evidence,
 ) -> Result<(), String> {
     let ks: &[usize] = if a.quick {
@@ -571,13 +725,27 @@ fn k_sweep(
             ladder: vec![amount],
             layer: None,
         };
-        let r = rung(
-            make, &t, amount, a.seeds, reference, regions, cache, a.threads,
-        )?;
+        let key = done.key(make, &t, amount, a.seeds, false)?;
+        let (r, again) = match done.get(&key, ev) {
+            Some(r) => (
+                RungResult {
+                    technique: t.name,
+                    ..r.clone()
+                },
+                " (the same runs as above)",
+            ),
+            None => (
+                rung(
+                    make, &t, amount, a.seeds, reference, regions, traces, a.threads,
+                )?,
+                "",
+            ),
+        };
         println!(
-            "k sweep {variant:<44} k {k:>5} {amount:>9} paths  relMSE {:.5}",
+            "k sweep {variant:<44} k {k:>5} {amount:>9} paths  relMSE {:.5}{again}",
             r.regions[0].errors.relmse
         );
+        done.0.insert(key, Ran::Sweep(ev.sweep.len()));
         ev.sweep.push(SweepResult {
             variant: variant.to_string(),
             k,

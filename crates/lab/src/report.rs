@@ -359,6 +359,9 @@ pub fn write(
          `evidence.json`.",
         ev.seeds, ev.seeds, ev.reference
     )));
+    if let Some(q) = &ev.quick {
+        blocks.push(Block::Para(q.clone()));
+    }
     for s in &ev.skipped {
         blocks.push(Block::Para(format!("Left out: {s}.")));
     }
