@@ -15,13 +15,14 @@
 //!   degenerate triangles, a sphere of radius 1e-4 (also seen up close), light power near the
 //!   f32 limit): every image finite, closed forms, flux and invariances where the scene
 //!   allows a check.
-//! - `references`: photonflow's images against Mitsuba 3's (`tests/references/`, two halves),
-//!   region by region, with negative controls that must fail.
+//! - `references`: every method's images of the worksheet scene against Mitsuba 3's
+//!   (`tests/references/`, two halves), region by region, with each method's known bias and
+//!   measured noise, and negative controls that must fail.
 //! - `photons`: photon flux against the path tracer (caustic flux under the glass sphere) and
 //!   against the light power (closed furnace box).
 //! - `photon_maps`: the photon-map methods through the pipeline library, trace to image: the
 //!   furnace against `Le / (1 - rho)` with the predicted k-NN bias, boundary correction on a
-//!   square and a sphere, global-direct and final gathering against the path tracer.
+//!   square and a sphere.
 //! - `splat`: photon differential splatting through the pipeline library: the splatted
 //!   caustic and `path+splat` against the path tracer on the worksheet scene, bounded chunks
 //!   in flight, a hostile scene (finite pixels, flux kept), the same bits on 1 and 2 threads.
