@@ -122,9 +122,10 @@ fn boundary_correction_removes_the_darkening_at_an_edge_and_a_corner() {
     // A 4 x 4 floor with photons of uniform density (irradiance E0 = 1) and nothing beyond
     // it: plain estimates near the edge see half a disc of photons (a quarter in the corner),
     // corrected ones divide by the kernel mass on the floor and recover E0.
-    use crate::boundary::kernel_mass_on_surface;
+    use crate::maps::Maps;
     use density::{EstimateParams, IndexKind, Kernel, KnnHint, PhotonMap};
     use glam::Vec3;
+    use store::{MapKind, PerKind};
     let dir = scratch("edge");
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(
@@ -150,7 +151,6 @@ fn boundary_correction_removes_the_darkening_at_an_edge_and_a_corner() {
             store::Photon::new(p, Vec3::splat(power), -Vec3::Y, 0)
         })
         .collect();
-    let map = PhotonMap::build(photons, IndexKind::KdTree);
     // Edge points: 20 along each of the 4 edges, a disc radius (~0.08) or more apart, so the
     // estimates are nearly independent; corner points: the 4 corners. One k = 1000 estimate
     // has relative noise ~1.5/sqrt(1000) = 5%: the means then carry ~0.8% (edges) and ~2.4%
@@ -180,17 +180,28 @@ fn boundary_correction_removes_the_darkening_at_an_edge_and_a_corner() {
             drop_kth: true,
             ..Default::default()
         };
+        // The estimate the eye pass reads (`Maps::estimate`), with and without the scene
+        // for the correction.
+        let mut maps = Maps {
+            maps: PerKind([
+                Some(PhotonMap::build(photons.clone(), IndexKind::KdTree)),
+                None,
+            ]),
+            params: PerKind([est, est]),
+            boundary: None,
+            gather_cache: None,
+        };
         for (name, points, plain_expect) in [("edge", &edges, 0.5), ("corner", &corners, 0.25)] {
             let (mut plain, mut corrected) = (0.0f64, 0.0f64);
             let mut scratch = Vec::new();
             for &x in points.iter() {
-                let mut hint = KnnHint::NONE;
-                let e = map
-                    .irradiance_hinted(x, Vec3::Y, &est, &mut hint, &mut scratch)
-                    .x;
-                let m = kernel_mass_on_surface(&scene, x, Vec3::Y, hint.r, &est);
-                plain += e as f64;
-                corrected += (e / m) as f64;
+                for (boundary, sum) in [(None, &mut plain), (Some(&scene), &mut corrected)] {
+                    maps.boundary = boundary;
+                    let mut hint = KnnHint::NONE;
+                    let (e, _) =
+                        maps.estimate(MapKind::Global, x, Vec3::Y, &mut hint, &mut scratch);
+                    *sum += e.x as f64;
+                }
             }
             let q = points.len() as f64;
             let (plain, corrected) = (plain / q, corrected / q);
