@@ -65,9 +65,9 @@ pub fn kernel_mass_on_surface(
     for ring in 0..4 {
         let t = ((ring as f32 + 0.5) / 4.0).sqrt();
         let w = params.kernel.weight(t as f64);
-        for a in 0..8 {
+        for (a, &out) in outer.iter().enumerate() {
             all += w;
-            let hit = if ring == 3 { outer[a] } else { hits(ring, a) };
+            let hit = if ring == 3 { out } else { hits(ring, a) };
             if hit {
                 on += w;
             }
