@@ -354,11 +354,9 @@ fn common_checks(o: &Overrides, r: &Rendered) {
         let bad: Vec<(usize, [f32; 3])> = bad_pixels(&l.image).into_iter().take(5).collect();
         assert!(bad.is_empty(), "{m}: layer {}: pixels {bad:?}", l.name);
     }
+    // A mean in f64 of finite f32 pixels is finite: only the light needs checking.
     let total = mean(&image(r));
-    assert!(
-        total.max_element() > 0.0 && total.is_finite(),
-        "{m}: image mean {total}"
-    );
+    assert!(total.max_element() > 0.0, "{m}: image mean {total}");
 }
 
 /// The image: the sum of every layer, in f64.
@@ -1177,8 +1175,8 @@ fn check_point_photons(ctx: &Ctx) {
             "1000 photons at one point, k = {k}: {inside} pixels within the closed-form \
              bounds, the pixel holding the point reads {centre:.1}"
         );
+        // The pixel holding the point is finite like every pixel (`common_checks`).
         assert!(inside >= 20, "{inside}");
-        assert!(centre.is_finite());
     }
     // The estimate itself at and next to the point, where no eye sample lands: read from the
     // photon file as the method reads it. At the point r = 0 (zero, by the estimate's

@@ -482,8 +482,9 @@ fn a_hostile_scene_splats_finite_non_negative_light_and_keeps_the_flux() {
     let img = layer(&render_uncached(&scene, &o, None), "caustic").clone();
     let bad = bad_pixels(&img);
     assert!(bad.is_empty(), "pixels {bad:?}");
+    // Every pixel is finite and non-negative (above): some light arrives.
     let total: f64 = img.data.iter().map(|p| p[0] as f64).sum();
-    assert!(total > 0.0 && total.is_finite(), "{total}");
+    assert!(total > 0.0, "{total}");
 
     // The caustic photons themselves: finite, and exactly the caustic map's (the same
     // streams, so nothing is dropped for a footprint that went bad).
