@@ -10,7 +10,8 @@
 #             OpenEXR, numpy); or PEERS_PYTHON=its python
 # VARIANT     Mitsuba variant, default llvm_ad_rgb (needs libLLVM >= 16); scalar_rgb is slower
 #             and draws different random numbers, so its images differ within noise
-# NAME        cornell-spheres-analytic, furnace, plane-light, corner (default: all)
+# NAME        cornell-spheres-analytic, cornell-spheres-closeup, furnace, plane-light, corner
+#             (default: all)
 # `stats` prints the noise figures of the halves present (the tables of README.md).
 #
 # The scenes are read from scenes/*.toml of this repository (camera, and checks that the
@@ -126,11 +127,14 @@ EOF
 P=$PEERS/worksheet
 S=$REPO/scenes
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic furnace plane-light corner)
+[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup furnace plane-light corner)
 for n in "${names[@]}"; do
   case $n in
     cornell-spheres-analytic)
       render $n worksheet "$S/cornell-spheres/analytic.toml" 128 128 8192 1024 \
+        "$P/cornell_worksheet_box.obj" --spheres "$P/cornell_worksheet_spheres.json" ;;
+    cornell-spheres-closeup)
+      render $n worksheet "$S/cornell-spheres/closeup.toml" 128 128 8192 1024 \
         "$P/cornell_worksheet_box.obj" --spheres "$P/cornell_worksheet_spheres.json" ;;
     furnace)
       render $n obj "$S/furnace/furnace.toml" 16 16 16384 16384 "$S/furnace/box.obj"
