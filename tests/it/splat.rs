@@ -677,4 +677,3 @@ fn splatting_is_bit_identical_on_one_and_two_threads() {
     assert!(v1 == v2, "eye vertices differ");
     assert!(sums1 == sums2, "the f64 sums differ");
 }
-
