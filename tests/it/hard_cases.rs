@@ -566,7 +566,7 @@ fn camera_in_glass(_: &Path) -> Scene {
 fn check_camera_in_glass(ctx: &Ctx) {
     let scene = ctx.scene;
     // The expected view: every camera ray leaves through the glass at normal incidence, the
-    // sphere's radius away (f64 sphere roots: measured to 1e-7 relative).
+    // sphere's radius away (f64 sphere roots: measured to 1.2e-7 relative).
     let glass = scene
         .material_of("glass")
         .unwrap_or_else(|| panic!("no glass"));
@@ -585,14 +585,15 @@ fn check_camera_in_glass(ctx: &Ctx) {
     }
     eprintln!("camera in glass: every ray leaves at t = r (1 {worst:+.1e})");
     assert!(worst < 1e-5, "{worst}");
-    // The methods agree on what the box looks like through the glass (measured against the
-    // path tracer's image mean: sppm -0.3% to -0.9%, final gathering +1.6% to +2.1% per
-    // channel; global-direct and the splat show only part of the light).
+    // The methods agree on what the box looks like through the glass (global-direct and the
+    // splat show only part of the light). Measured against the path tracer's image mean,
+    // one run per seed over seeds 1 to 16, largest channel: sppm -0.6% ± 3.7% (mean ± sd of
+    // one run), final gathering -1.1% ± 2.9%; each tolerance is the mean plus 4 sd.
     let path = image(run_of(ctx, Method::Path));
-    for m in [Method::Sppm, Method::FinalGather] {
+    for (m, tol) in [(Method::Sppm, 0.15), (Method::FinalGather, 0.12)] {
         let d = rel_diff(&image(run_of(ctx, m)), &path);
         eprintln!("camera in glass: {m} against path {d:+.3}");
-        assert!(d.abs().max_element() < 0.06, "{m}: {d}");
+        assert!(d.abs().max_element() < tol, "{m}: {d}");
     }
 }
 
@@ -660,17 +661,22 @@ fn check_light_under_ceiling(ctx: &Ctx) {
         .map(|&i| (i, direct[i]))
         .collect();
     assert!(leak.is_empty(), "direct light on the ceiling: {leak:?}");
-    // And the ceiling is lit indirectly, alike by every method (measured against the path
-    // tracer over the ceiling's pixels: global-direct -1% to -5%, final gathering -5% to
-    // -7%, sppm -1% to +3%; the path tracer's 16 samples per pixel are a few percent noisy
-    // there).
+    // And the ceiling is lit indirectly, alike by every method. Measured against the path
+    // tracer over the ceiling's pixels, one run per seed over seeds 1 to 16, worst channel
+    // (mean ± sd of one run): global-direct -4.5% ± 3.6%, final gathering -11.5% ± 3.7%
+    // (its smoothing reads the ceiling round the light low), sppm +1.1% ± 3.7%; each
+    // tolerance is the mean's size plus 4 sd.
     let ceiling_mean = |img: &[DVec3]| ceiling.iter().map(|&i| img[i]).sum::<DVec3>();
     let path = ceiling_mean(&image(run_of(ctx, Method::Path)));
     assert!(path.min_element() > 0.0, "{path}");
-    for m in [Method::GlobalDirect, Method::FinalGather, Method::Sppm] {
+    for (m, tol) in [
+        (Method::GlobalDirect, 0.19),
+        (Method::FinalGather, 0.27),
+        (Method::Sppm, 0.16),
+    ] {
         let d = (ceiling_mean(&image(run_of(ctx, m))) - path) / path;
         eprintln!("light under the ceiling: ceiling {m} against path {d:+.3}");
-        assert!(d.abs().max_element() < 0.15, "{m}: {d}");
+        assert!(d.abs().max_element() < tol, "{m}: {d}");
     }
 }
 
@@ -728,14 +734,15 @@ fn check_grazing(ctx: &Ctx) {
         .iter()
         .map(|(a, b)| c + 0.25 * DVec3::new(*a, 0.0, *b))
         .collect();
-    // The floor's radiance from the light alone, averaged over a pixel on a 6 x 6 grid of
-    // film points (the path tracer's samples are uniform over the pixel). Pixels whose
-    // corners all land on the floor only.
+    // The floor's radiance from the light alone, averaged over a pixel on a 16 x 16 grid of
+    // film points (the path tracer's samples are uniform over the pixel): a 6 x 6 grid read
+    // the far pixels' integral 0.05% low, which the z score below resolved (z = 2 on
+    // average over seeds). Pixels whose corners all land on the floor only.
     let expected = |x: usize, y: usize| -> Option<DVec3> {
         for (u, v) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
             on_floor(scene, x as f32 + u, y as f32 + v, 9.9)?;
         }
-        let n = 6;
+        let n = 16;
         let mut sum = 0.0;
         for j in 0..n {
             for i in 0..n {
@@ -770,23 +777,30 @@ fn check_grazing(ctx: &Ctx) {
          Lambert's formula {d:+.4} (z = {z:.2})",
         pixels.len()
     );
-    // Measured: +0.03%, z = 0.26 (the pixels' errors are independent: a z score).
+    // The pixels' errors are independent: a z score. Measured: +0.01%, z = 0.47; over seeds
+    // 1 to 16 (one run each) |z| at most 2.5 and |d| at most 0.06%.
     assert!(z < 4.0, "path: z = {z}, {d}");
     // The photon methods see the same floor (direct and indirect; the lamp is black, so the
-    // indirect light is nil) with their smoothing (measured: global-direct +5.7%, final
-    // gathering -0.8%, sppm +0.8%).
-    let ds: Vec<(Method, DVec3)> = [Method::GlobalDirect, Method::FinalGather, Method::Sppm]
-        .into_iter()
-        .map(|m| {
-            let img = image(run_of(ctx, m));
-            let got: Vec<DVec3> = pixels.iter().map(|&(i, _)| img[i]).collect();
-            let d = rel_diff(&got, &want);
-            eprintln!("grazing: {m} against Lambert's formula {d:+.4}");
-            (m, d)
-        })
-        .collect();
-    for (m, d) in ds {
-        assert!(d.abs().max_element() < 0.1, "{m}: {d}");
+    // indirect light is nil) with their smoothing. Measured: global-direct +5.7%, final
+    // gathering -0.9%, sppm +0.7%; over seeds 1 to 16 (mean ± sd of one run) +3.6% ± 13%
+    // (few photons reach the far floor, and its k-NN discs are wide: -13% to +42%), +0.6% ±
+    // 1.0%, +0.2% ± 0.3%. Each tolerance is the mean's size plus 4 sd.
+    let ds: Vec<(Method, f64, DVec3)> = [
+        (Method::GlobalDirect, 0.6),
+        (Method::FinalGather, 0.05),
+        (Method::Sppm, 0.015),
+    ]
+    .into_iter()
+    .map(|(m, tol)| {
+        let img = image(run_of(ctx, m));
+        let got: Vec<DVec3> = pixels.iter().map(|&(i, _)| img[i]).collect();
+        let d = rel_diff(&got, &want);
+        eprintln!("grazing: {m} against Lambert's formula {d:+.4}");
+        (m, tol, d)
+    })
+    .collect();
+    for (m, tol, d) in ds {
+        assert!(d.abs().max_element() < tol, "{m}: {d}");
     }
 }
 
@@ -924,8 +938,9 @@ fn check_tir(ctx: &Ctx) {
         landed.len(),
         share.x
     );
-    // Measured: 0.6773 against 0.6771 ± 0.0011, z = 0.13; with the caustic tracer cut at 4
-    // surface hits instead of 16 (tried), 0.6666 and z = -9.2. Without a cap on surface
+    // Measured: 0.6778 against 0.6783 ± 0.0011, z = -0.39; over seeds 1 to 16, z = +0.2 ±
+    // 1.2 (mean ± sd), |z| at most 2.5. With the caustic tracer cut at 4 surface hits
+    // instead of 64 (tried), 0.6666 and z = -10.3; at 16, z = -0.9. Without a cap on surface
     // hits the trapped paths (every direction component below the cosine of the critical
     // angle, 0.745) would never end.
     assert!(z.abs() < 4.0, "z = {z}");
@@ -1017,17 +1032,20 @@ fn check_focus(ctx: &Ctx) {
         ps.len(),
         pixels.len()
     );
-    // Measured: 61 of 854 below 1e-3, the smallest 1.1e-4 (the lamp is 0.3 wide, so no
-    // footprint shrinks to exactly zero; the clamps take over below the eye's spacing).
+    // Measured: 61 of 854 below 1e-3, the smallest 1.1e-4; over seeds 1 to 16, 53 to 92, the
+    // smallest 1.0e-4 to 1.3e-4 (the lamp is 0.3 wide, so no footprint shrinks to exactly
+    // zero; the clamps take over below the eye's spacing).
     assert!(focused > 30, "the light is not focused: {focused}");
     assert!(photon_flux > 0.5 * all_flux, "{photon_flux} of {all_flux}");
-    // Measured: +2.5% (the eye vertices' sampling of the focus, 16 per pixel, and splats
-    // crossing the ball's silhouette). Before each spacing level of eye vertices read the
-    // photons through its own footprint (`density::splat::Receivers`), -24%: a focused
-    // photon's footprint was clamped to the spacing of its nearest vertex, often one seen
-    // through the ball, and fell between the directly seen floor's vertices (16 passes:
-    // -20%, so a bias, not noise).
-    assert!(rel.abs() < 0.06, "{rel}");
+    // Measured: +2.5%; over seeds 1 to 16, -2.6% ± 4.6% (mean ± sd of one run, -9.9% to
+    // +6.5%: the eye vertices' sampling of the focus, 16 per pixel, and splats crossing the
+    // ball's silhouette), so the tolerance is the mean's size plus 4 sd. Before each spacing
+    // level of eye vertices read the photons through its own footprint
+    // (`density::splat::Receivers`), -24%: a focused photon's footprint was clamped to the
+    // spacing of its nearest vertex, often one seen through the ball, and fell between the
+    // directly seen floor's vertices (16 passes: -20%, so a bias, not noise). At this
+    // budget the check only just tells that apart from noise.
+    assert!(rel.abs() < 0.22, "{rel}");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1241,8 +1259,9 @@ fn check_k_above_count(ctx: &Ctx) {
         "k above the photon count: {inside} pixels read Phi / (pi r_max^2) exactly; the image \
          integrates to {flux:.5} W of 1"
     );
-    // The disc's edge pixels are sampled by 16 eye samples each: measured 0.9973.
-    assert!((flux - 1.0).abs() < 0.02, "{flux}");
+    // The disc's edge pixels are sampled by 16 eye samples each: measured 1.0017; over seeds
+    // 1 to 16, 1.0013 ± 0.0027 (mean ± sd of one run): the mean's size plus 5 sd.
+    assert!((flux - 1.0).abs() < 0.015, "{flux}");
     assert!(inside >= 20, "{inside}");
     // Final gathering reads the same estimate at its gather rays' hits (the common checks:
     // finite, non-negative, some light).
@@ -1308,11 +1327,13 @@ fn check_scaled(ctx: &Ctx) {
     // one's paths until rounding sends one elsewhere (most pixels then differ in their last
     // bits, a few by a path). Any length left unscaled (an absolute epsilon, a radius in
     // scene units) would show as a bias far above that. Measured, largest channel: at 1e-3
-    // path below 5e-7, final gathering 3.3e-4, caustic-splat 1e-5, sppm 3.4e-4; at 1e4
-    // below 5e-7, 2.6e-4, 1e-5, 1.9e-4. One run's image mean varies between seeds (8) by 3.2%
-    // (path), 17.5% (final gathering), 6.8% (caustic-splat) and 7.1% (sppm): the tolerance
-    // below is a small fraction of any method's noise. With the sppm radius left unscaled
-    // (tried), sppm reads -34% at both scales.
+    // path 1e-6, final gathering 1.6e-4, caustic-splat 2.4e-4, sppm 5.1e-4; at 1e4 1e-6,
+    // 2.6e-4, 5.6e-4, 2.9e-4. Over seeds 1 to 16 the largest is 1.5e-3 (caustic-splat at
+    // 1e-3), and the tolerance is about 4 sd of caustic-splat's spread (5e-4) over those
+    // seeds. One run's image mean varies between seeds (1 to 8) by 3.7% (path), 25% (final
+    // gathering), 9.1% (caustic-splat) and 9.9% (sppm): the tolerance is a small fraction of
+    // any method's noise. With the sppm radius left unscaled (tried), sppm reads -34% at
+    // 1e4 (at 1e-3 the settings refuse a radius that large).
     let t = 2e-3;
     against_reference(
         ctx,
@@ -1411,19 +1432,21 @@ fn check_tiny_sphere_close(ctx: &Ctx) {
     );
     assert!(ball.len() >= 100, "{}", ball.len());
     assert!(worst < 1e-4, "{worst}");
-    // Through the ball: the room, inverted, alike by the path tracer and the photon methods
-    // (measured against the path tracer over the ball's pixels: final gathering -1% to
-    // +1.5%, sppm +6% to +8.5%, per channel).
+    // Through the ball: the room, inverted, alike by the path tracer and the photon methods.
+    // Measured against the path tracer over the ball's pixels: final gathering -2.4% to
+    // -4.7%, sppm +3.0% to +4.5% per channel; over seeds 1 to 16 (mean ± sd of one run,
+    // worst channel) -2.0% ± 5.3% and -0.4% ± 10.6% (192 pixels, 4 sppm passes of 10 000
+    // photons). Each tolerance is the mean's size plus 4 sd.
     let over_ball = |r: &Rendered| {
         let img = image(r);
         ball.iter().map(|&i| img[i]).sum::<DVec3>() / ball.len() as f64
     };
     let path = over_ball(run_of(ctx, Method::Path));
     assert!(path.min_element() > 0.0, "{path}");
-    for m in [Method::FinalGather, Method::Sppm] {
+    for (m, tol) in [(Method::FinalGather, 0.23), (Method::Sppm, 0.43)] {
         let d = (over_ball(run_of(ctx, m)) - path) / path;
         eprintln!("sphere of radius 1e-4 up close: {m} against path over the ball {d:+.3}");
-        assert!(d.abs().max_element() < 0.15, "{m}: {d}");
+        assert!(d.abs().max_element() < tol, "{m}: {d}");
     }
 }
 
@@ -1514,7 +1537,8 @@ fn check_huge_power(ctx: &Ctx) {
     assert!(p.x > 0.8 * f32::MAX && p.x.is_finite(), "{p}");
     // Radiance is linear in the emission: every pixel of every layer is the unit light's
     // times HUGE_LE, to f32 rounding (the same seed draws the same paths). Measured: at most
-    // 1.5e-7 relative in any pixel of any method (pixels below 1e-3 compared absolutely).
+    // 1.4e-7 relative in any pixel of any method, 1.8e-7 over seeds 1 to 16 (pixels below
+    // 1e-3 compared absolutely).
     let unit = power_scene(ctx.dir, 1.0).unwrap_or_else(|e| panic!("{e}"));
     let cache = ctx.dir.join("unit-cache");
     for (o, r) in ctx.runs {

@@ -68,8 +68,8 @@ const PATH_SPP: u32 = 256;
 const PATH_SPLAT_SPP: u32 = 128;
 /// Eye vertices per pixel of the splat (`[estimate] spp`) and its caustic paths. The splat's
 /// noise is mostly where its eye vertices fall in the focused caustic, not its photons: at 64
-/// vertices per pixel and 250 000 paths one run's caustic region is 4.6% noisy, at 4 and
-/// 1 000 000 13%.
+/// vertices per pixel and 250 000 paths one run's caustic region is 4.2% noisy, at 4 and
+/// 1 000 000 17% (measured over 8 seeds each).
 const SPLAT_SPP: u32 = 64;
 const SPLAT_PHOTONS: u64 = 250_000;
 
@@ -159,15 +159,15 @@ fn splatted_caustic_under_the_glass_sphere_matches_the_path_tracer() {
         pt.mean(),
         pt_all.mean()
     );
-    // Both sides resolve it to a few percent (measured: splat 1.6%, path 2.4%, so 2.9%
-    // combined; over the whole image 0.9% and 0.9%): splatted flux 15% too high reads
-    // z = 4.2 over the region and 11 over the image.
+    // Both sides resolve it to a few percent (measured: splat 1.5%, path 1.9%, so 2.5%
+    // combined; over the whole image 0.9% and 1.6%): splatted flux 15% too high reads
+    // z = 6 over the region and 8 over the image.
     //
     // The splat's smoothing bias (footprints of at least an eye vertex's spacing, at most 2%
     // of the scene's diagonal) is below this resolution: against 24 runs of the path tracer
     // at 256 samples per pixel, 8 splat runs at 256 eye vertices per pixel and 10^6 paths
-    // read -2.2% ± 1.8% over the region and -1.2% ± 1.1% over the image; 16 runs at 64 and
-    // 500 000, -0.6% ± 2.0% and -0.9% ± 1.2%.
+    // read +2.0% ± 1.9% over the region and +0.9% ± 1.3% over the image (largest channel);
+    // 16 runs at 64 and 500 000, +1.3% ± 1.9% and -0.6% ± 1.2%.
     for (name, m) in [("splat", &sp), ("path", &pt)] {
         assert!(
             (m.se() / m.mean()).max_element() < 0.04,
@@ -227,9 +227,10 @@ fn path_without_its_caustics_plus_the_splat_is_the_path_tracer() {
     ];
     // Each region's mean per run; a method's standard error is the spread of its RUNS
     // independent runs over sqrt(RUNS); the two combine in quadrature. Measured: |z| below 2
-    // in every region and channel (largest: floor -1.8, glass sphere -1.9, walls -1.6), with
-    // standard errors of 0.1% (image) to 2.9% (caustic); with the path tracer's caustics left
-    // in path+splat the image reads z = +12, with its caustic_indirect paths dropped -27.
+    // in every region and channel (largest: image -1.9, silver sphere -1.6, walls -1.0), with
+    // standard errors of 0.08% (image) to 1.5% (caustic). From the shares printed, the path
+    // tracer's caustics left in path+splat would read z = +23 over the image, its
+    // caustic_indirect paths dropped -24 to -47 per channel.
     let full: Vec<film::Image> = runs.path.iter().map(|r| sum_layers(r, |_| true)).collect();
     let split: Vec<film::Image> = runs
         .path_splat

@@ -446,13 +446,14 @@ fn caustic_photons_lie_on_diffuse_surfaces_and_gather_under_the_glass_sphere() {
     let under_silver = near(silver, 4.5) / all;
     // Measured (20k paths, seed 1): 666 floor caustic photons, 0.85 of their flux within 2r of
     // the glass sphere's footprint, 0.78 within 1r (8% of the floor), 0.08 under the silver one.
-    // Binomial standard error ~0.015: the bounds sit > 5 SE away.
-    assert!(floor.len() > 400, "{} floor caustic photons", floor.len());
+    // Over seeds 1 to 12 (mean ± sd of one run): 671 ± 21 photons, 0.869 ± 0.016, 0.812 ±
+    // 0.018, 0.077 ± 0.011; each bound sits 5 sd from the mean.
+    assert!(floor.len() > 570, "{} floor caustic photons", floor.len());
     assert!(
-        within_2r > 0.75 && within_1r > 0.65,
+        within_2r > 0.79 && within_1r > 0.72,
         "{within_2r:.3}, {within_1r:.3}"
     );
-    assert!(under_silver < 0.2, "{under_silver:.3}");
+    assert!(under_silver < 0.13, "{under_silver:.3}");
 }
 
 #[test]
@@ -618,9 +619,10 @@ fn photons_record_their_surface_and_direction_of_travel() {
             ..params(2000)
         },
     );
-    // The corner is open: 1077 of 2000 paths hit it (seed 1).
+    // The corner is open: 1077 of 2000 paths hit it (seed 1); over seeds 1 to 12, 1031 ± 20
+    // (mean ± sd of one run), and the bound sits 5 sd below.
     assert!(
-        t[MapKind::Global].len() > 900,
+        t[MapKind::Global].len() > 930,
         "{} of 2000 paths hit",
         t[MapKind::Global].len()
     );
