@@ -8,6 +8,8 @@ use math::Rng;
 use math::chi2::chi2_test_sidak;
 use std::f32::consts::{FRAC_1_PI, PI};
 
+mod microfacet;
+
 const RAD: TransportMode = TransportMode::Radiance;
 const IMP: TransportMode = TransportMode::Importance;
 
