@@ -37,7 +37,7 @@ fn rough_glass(alpha: f32) -> Bsdf {
 fn glossy(alpha: f32) -> Bsdf {
     Glossy {
         albedo: Vec3::new(0.5, 0.3, 0.1),
-        specular: Vec3::new(0.3, 0.4, 0.2),
+        specular: Vec3::new(0.2, 0.3, 0.1),
         alpha,
     }
     .into()
@@ -348,11 +348,11 @@ fn samples_agree_with_f_and_pdf() {
 
 #[test]
 fn glossy_picks_its_lobes_by_mean_reflectance() {
-    // pd = mean(albedo) / (mean(albedo) + mean(specular)) = 0.3 / 0.6; the lobe count is
+    // pd = mean(albedo) / (mean(albedo) + mean(specular)) = 0.3 / 0.5; the diffuse count is
     // Binomial(n, pd): 5 standard deviations.
     let b = glossy(0.3);
     let Bsdf::Glossy(g) = b else { unreachable!() };
-    assert!((g.diffuse_probability() - 0.5).abs() < 1e-6);
+    assert!((g.diffuse_probability() - 0.6).abs() < 1e-6);
     let black = Glossy {
         albedo: Vec3::ZERO,
         specular: Vec3::ZERO,
@@ -366,9 +366,9 @@ fn glossy_picks_its_lobes_by_mean_reflectance() {
         .filter_map(|_| b.sample(wo, rng.uniform(), rng.uniform2(), RAD))
         .filter(|s| s.flags == Flags::DIFFUSE_REFLECTION)
         .count();
-    let sd = (n as f64 * 0.25).sqrt();
+    let sd = (n as f64 * 0.6 * 0.4).sqrt();
     assert!(
-        (diffuse as f64 - 0.5 * n as f64).abs() < 5.0 * sd,
+        (diffuse as f64 - 0.6 * n as f64).abs() < 5.0 * sd,
         "{diffuse} / {n}"
     );
 }
@@ -498,6 +498,28 @@ fn white_furnace_never_gains_and_loses_little_when_smooth() {
             (e - want).abs() <= 4.0 * se + 1e-6,
             "a={a}: {e} ± {se} vs {want}"
         );
+    }
+}
+
+#[test]
+fn rough_gold_albedo_follows_its_fresnel_term() {
+    // At alpha 0.05 microfacets stay within a few degrees of the normal, so the albedo is the
+    // white reflector's times F(cos θo), up to F's change over that spread. Same seeds for
+    // both (common random numbers), so noise nearly cancels. Measured worst difference 5e-4
+    // (blue, 45°); allowed 3e-3. Without F the difference is 0.04 to 0.68.
+    for (k, th) in [0.0f32, 30.0, 45.0, 60.0].into_iter().enumerate() {
+        let wo = dir(th, 20.0);
+        let white: Bsdf = RoughConductor {
+            alpha: 0.05,
+            reflectance: Vec3::ONE,
+            eta: None,
+        }
+        .into();
+        let seed = 760 + k as u64;
+        let (eg, _) = albedo(&rough_gold(0.05), wo, IMP, 20_000, seed);
+        let (ew, _) = albedo(&white, wo, IMP, 20_000, seed);
+        let want = fresnel_conductor(wo.z, GOLD_ETA, GOLD_K) * ew;
+        assert!(eg.distance(want) < 3e-3, "theta {th}: {eg} vs {want}");
     }
 }
 

@@ -11,7 +11,7 @@ photonflow's `f`. Models (scalar_rgb, GGX, visible-normal sampling, ext_ior 1):
   rc_none   roughconductor, material none, specular_reflectance (0.9, 0.6, 0.3)
   rc_gold   roughconductor, eta (0.143, 0.374, 1.442), k (3.983, 2.385, 1.603)
   rd        roughdielectric, int_ior 1.5, ext_ior 1.0, Radiance and Importance modes
-  glossy    diffuse Kd (0.5, 0.3, 0.1) + roughconductor (material none) Ks (0.3, 0.4, 0.2):
+  glossy    diffuse Kd (0.5, 0.3, 0.1) + roughconductor (material none) Ks (0.2, 0.3, 0.1):
             f = sum of the two evals; pdf = pd diffuse + (1 - pd) GGX, pd = mean Kd / (mean Kd
             + mean Ks), the MTL illum 2 mapping photonflow's `Glossy` implements
 """
@@ -24,7 +24,7 @@ import mitsuba as mi
 mi.set_variant("scalar_rgb")
 
 ALPHAS = [0.05, 0.3, 0.8]
-KD, KS = [0.5, 0.3, 0.1], [0.3, 0.4, 0.2]
+KD, KS = [0.5, 0.3, 0.1], [0.2, 0.3, 0.1]
 GOLD_ETA, GOLD_K = [0.143, 0.374, 1.442], [3.983, 2.385, 1.603]
 RC_NONE_R = [0.9, 0.6, 0.3]
 
