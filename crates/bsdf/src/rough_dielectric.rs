@@ -16,7 +16,7 @@ pub struct RoughDielectric {
 }
 
 /// The microfacet normal relating `wo` and `wi`, facing +z, and the relative index `η'` crossed
-/// (1 for reflection), or `None` for a degenerate or back-facing configuration.
+/// (1 for reflection).
 struct Geometry {
     wm: Vec3,
     etap: f32,
@@ -30,7 +30,8 @@ impl RoughDielectric {
     }
 
     /// Generalized half vector `wm ∝ wo + η' wi` (Walter et al. 2007, eq. 16; pbrt-v4 eq. 9.34),
-    /// which for reflection (`η' = 1`) is the usual half vector.
+    /// which for reflection (`η' = 1`) is the usual half vector; `None` for a degenerate or
+    /// back-facing configuration.
     fn geometry(&self, wo: Vec3, wi: Vec3) -> Option<Geometry> {
         let (cos_o, cos_i) = (wo.z, wi.z);
         if cos_o == 0.0 || cos_i == 0.0 {
