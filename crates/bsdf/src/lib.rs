@@ -13,17 +13,25 @@
 
 mod conductor;
 mod dielectric;
+mod glossy;
 mod lambertian;
 mod metal;
+pub mod microfacet;
 mod mirror;
 pub mod optics;
+mod rough_conductor;
+mod rough_dielectric;
 
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
+pub use glossy::Glossy;
 pub use lambertian::Lambertian;
 pub use metal::Metal;
+pub use microfacet::TrowbridgeReitz;
 pub use mirror::Mirror;
 pub use optics::{fresnel_conductor, fresnel_dielectric, reflect, refract};
+pub use rough_conductor::RoughConductor;
+pub use rough_dielectric::RoughDielectric;
 
 use glam::Vec3;
 use std::ops::BitOr;
@@ -37,8 +45,8 @@ pub enum TransportMode {
     Importance,
 }
 
-/// Lobe kind of a sample: reflection or transmission, diffuse or specular (pbrt-v4 §9.1.2's
-/// `BxDFFlags`, reduced to what these models produce).
+/// Lobe kind of a sample: reflection or transmission, diffuse, glossy or specular (pbrt-v4
+/// §9.1.2's `BxDFFlags`, reduced to what these models produce).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Flags(u8);
 
@@ -47,9 +55,12 @@ impl Flags {
     pub const TRANSMISSION: Flags = Flags(2);
     pub const DIFFUSE: Flags = Flags(4);
     pub const SPECULAR: Flags = Flags(8);
+    pub const GLOSSY: Flags = Flags(16);
     pub const DIFFUSE_REFLECTION: Flags = Flags(1 | 4);
     pub const SPECULAR_REFLECTION: Flags = Flags(1 | 8);
     pub const SPECULAR_TRANSMISSION: Flags = Flags(2 | 8);
+    pub const GLOSSY_REFLECTION: Flags = Flags(1 | 16);
+    pub const GLOSSY_TRANSMISSION: Flags = Flags(2 | 16);
 
     #[inline]
     pub const fn contains(self, other: Flags) -> bool {
@@ -70,6 +81,10 @@ impl Flags {
     #[inline]
     pub const fn is_specular(self) -> bool {
         self.contains(Flags::SPECULAR)
+    }
+    #[inline]
+    pub const fn is_glossy(self) -> bool {
+        self.contains(Flags::GLOSSY)
     }
 }
 
@@ -122,18 +137,24 @@ pub enum Bsdf {
     Metal(Metal),
     Conductor(Conductor),
     Dielectric(Dielectric),
+    RoughConductor(RoughConductor),
+    RoughDielectric(RoughDielectric),
+    Glossy(Glossy),
 }
 
 impl Bsdf {
     /// BSDF value for a pair of directions; 0 for delta models, whose value is a Dirac
     /// distribution no pair of directions drawn independently can hit.
-    pub fn f(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> Vec3 {
+    pub fn f(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Vec3 {
         // A grazing wo has no hemisphere (pbrt-v4 `BSDF::f`).
         if wo.z == 0.0 {
             return Vec3::ZERO;
         }
         match self {
             Bsdf::Lambertian(b) => b.f(wo, wi),
+            Bsdf::RoughConductor(b) => b.f(wo, wi),
+            Bsdf::RoughDielectric(b) => b.f(wo, wi, mode),
+            Bsdf::Glossy(b) => b.f(wo, wi),
             Bsdf::Mirror(_) | Bsdf::Metal(_) | Bsdf::Conductor(_) | Bsdf::Dielectric(_) => {
                 Vec3::ZERO
             }
@@ -147,11 +168,15 @@ impl Bsdf {
         }
         match self {
             Bsdf::Lambertian(b) => b.pdf(wo, wi),
+            Bsdf::RoughConductor(b) => b.pdf(wo, wi),
+            Bsdf::RoughDielectric(b) => b.pdf(wo, wi),
+            Bsdf::Glossy(b) => b.pdf(wo, wi),
             Bsdf::Mirror(_) | Bsdf::Metal(_) | Bsdf::Conductor(_) | Bsdf::Dielectric(_) => 0.0,
         }
     }
 
-    /// Sample `wi` given `wo`: `uc` picks a lobe (dielectric: reflect or refract), `u` the
+    /// Sample `wi` given `wo`: `uc` picks a lobe (dielectrics: reflect or refract; glossy:
+    /// diffuse or GGX), `u` the
     /// direction within it. `None` when no direction carries energy.
     pub fn sample(
         &self,
@@ -169,6 +194,9 @@ impl Bsdf {
             Bsdf::Metal(b) => b.sample(wo),
             Bsdf::Conductor(b) => b.sample(wo),
             Bsdf::Dielectric(b) => b.sample(wo, uc, mode),
+            Bsdf::RoughConductor(b) => b.sample(wo, u),
+            Bsdf::RoughDielectric(b) => b.sample(wo, uc, u, mode),
+            Bsdf::Glossy(b) => b.sample(wo, uc, u),
         }?;
         debug_assert!(s.pdf > 0.0 && s.f.is_finite(), "bad sample {s:?}");
         Some(s)
@@ -176,16 +204,46 @@ impl Bsdf {
 
     /// True when every lobe is a delta: light sampling cannot help, skip next-event estimation.
     pub fn is_delta(&self) -> bool {
-        !matches!(self, Bsdf::Lambertian(_))
+        matches!(
+            self,
+            Bsdf::Mirror(_) | Bsdf::Metal(_) | Bsdf::Conductor(_) | Bsdf::Dielectric(_)
+        )
     }
 
-    /// True for a diffuse lobe: where photons are stored and density estimation is used.
+    /// True when the only lobe is Lambertian: where photons are stored and density estimation
+    /// is used. A [`Glossy`] surface has a diffuse part too: see [`Bsdf::diffuse_albedo`].
     pub fn is_diffuse(&self) -> bool {
         matches!(self, Bsdf::Lambertian(_))
     }
 
+    /// Albedo of the Lambertian lobe, if the model has one (Lambertian, and Glossy's base).
+    pub fn diffuse_albedo(&self) -> Option<Vec3> {
+        match self {
+            Bsdf::Lambertian(b) => Some(b.albedo),
+            Bsdf::Glossy(b) => Some(b.albedo),
+            _ => None,
+        }
+    }
+
+    /// True for a model with a microfacet (glossy) lobe.
+    pub fn is_glossy(&self) -> bool {
+        self.roughness().is_some()
+    }
+
+    /// GGX `alpha` of the microfacet lobe as evaluated (clamped to [`microfacet::MIN_ALPHA`]),
+    /// `None` for models without one.
+    pub fn roughness(&self) -> Option<f32> {
+        let alpha = match self {
+            Bsdf::RoughConductor(b) => b.alpha,
+            Bsdf::RoughDielectric(b) => b.alpha,
+            Bsdf::Glossy(b) => b.alpha,
+            _ => return None,
+        };
+        Some(TrowbridgeReitz::new(alpha).alpha_x)
+    }
+
     pub fn has_transmission(&self) -> bool {
-        matches!(self, Bsdf::Dielectric(_))
+        matches!(self, Bsdf::Dielectric(_) | Bsdf::RoughDielectric(_))
     }
 }
 
@@ -198,7 +256,16 @@ macro_rules! impl_from {
         }
     )*};
 }
-impl_from!(Lambertian, Mirror, Metal, Conductor, Dielectric);
+impl_from!(
+    Lambertian,
+    Mirror,
+    Metal,
+    Conductor,
+    Dielectric,
+    RoughConductor,
+    RoughDielectric,
+    Glossy
+);
 
 /// Both directions on the same side of the surface (local frame).
 #[inline]

@@ -107,10 +107,41 @@ pub fn chi2_test_sidak(
     phi_res: usize,
     sample_count: usize,
     seed: u64,
+    sample: impl FnMut(&mut Rng) -> Option<Vec3>,
+    pdf: impl Fn(Vec3) -> f64,
+) -> Result<(), String> {
+    chi2_test_sidak_sub(
+        test_count,
+        theta_res,
+        phi_res,
+        SUB,
+        sample_count,
+        seed,
+        sample,
+        pdf,
+    )
+}
+
+/// Sub-cells per cell side in the expected-count quadrature of [`chi2_test_sidak`].
+pub const SUB: usize = 4;
+
+/// [`chi2_test_sidak`] with `sub × sub` quadrature sub-cells per cell instead of [`SUB`]. For a
+/// pdf that jumps along a curve crossing cells (not only at the equator), e.g. a rough
+/// refraction lobe where the generalized half vector meets the horizon: quadrature error
+/// there shrinks with the sub-cell size, and a sliver of support is less likely to be missed
+/// by every node.
+#[allow(clippy::too_many_arguments)]
+pub fn chi2_test_sidak_sub(
+    test_count: u32,
+    theta_res: usize,
+    phi_res: usize,
+    sub: usize,
+    sample_count: usize,
+    seed: u64,
     mut sample: impl FnMut(&mut Rng) -> Option<Vec3>,
     pdf: impl Fn(Vec3) -> f64,
 ) -> Result<(), String> {
-    assert!(theta_res > 0 && phi_res > 0 && sample_count > 0);
+    assert!(theta_res > 0 && phi_res > 0 && sub > 0 && sample_count > 0);
     let mut observed = vec![0.0; theta_res * phi_res];
     let mut rng = Rng::new(seed);
     for i in 0..sample_count {
@@ -122,7 +153,7 @@ pub fn chi2_test_sidak(
         }
         observed[cell_of(w, theta_res, phi_res)] += 1.0;
     }
-    let expected = expected_counts(theta_res, phi_res, sample_count, &pdf);
+    let expected = expected_counts(theta_res, phi_res, sub, sample_count, &pdf);
     let mass = expected.iter().sum::<f64>() / sample_count as f64;
     if mass > 1.0 + 1e-3 {
         return Err(format!("seed {seed}: the pdf integrates to {mass} > 1"));
@@ -150,33 +181,33 @@ fn cell_of(w: Vec3, theta_res: usize, phi_res: usize) -> usize {
     row * phi_res + col
 }
 
-/// Expected counts: the pdf integrated over each cell by 2-point Gauss–Legendre on a 4 × 4
+/// Expected counts: the pdf integrated over each cell by 2-point Gauss–Legendre on a `sub × sub`
 /// grid of sub-cells (exact for cubics per sub-cell; Numerical Recipes §4.6). The nodes never
 /// sit on a sub-cell edge, and with odd `theta_res` the equator is such an edge, so a
 /// hemisphere pdf's jump is integrated exactly rather than smeared.
 fn expected_counts(
     theta_res: usize,
     phi_res: usize,
+    sub: usize,
     sample_count: usize,
     pdf: &impl Fn(Vec3) -> f64,
 ) -> Vec<f64> {
-    const SUB: usize = 4;
     let g = 0.5 / 3f64.sqrt();
     let nodes = [0.5 - g, 0.5 + g];
     let dz = 2.0 / theta_res as f64;
     let dphi = TAU / phi_res as f64;
-    let sub_area = (dz / SUB as f64) * (dphi / SUB as f64);
+    let sub_area = (dz / sub as f64) * (dphi / sub as f64);
     let mut out = Vec::with_capacity(theta_res * phi_res);
     for row in 0..theta_res {
         for col in 0..phi_res {
             let mut sum = 0.0;
-            for sz in 0..SUB {
+            for sz in 0..sub {
                 for nz in nodes {
-                    let z = 1.0 - (row as f64 + (sz as f64 + nz) / SUB as f64) * dz;
+                    let z = 1.0 - (row as f64 + (sz as f64 + nz) / sub as f64) * dz;
                     let r = (1.0 - z * z).max(0.0).sqrt();
-                    for sp in 0..SUB {
+                    for sp in 0..sub {
                         for np in nodes {
-                            let phi = (col as f64 + (sp as f64 + np) / SUB as f64) * dphi;
+                            let phi = (col as f64 + (sp as f64 + np) / sub as f64) * dphi;
                             let w =
                                 Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32);
                             sum += pdf(w);

@@ -1,4 +1,6 @@
-use crate::chi2::{chi2_test, gamma_p, gamma_q, ln_gamma, pearson, sidak_alpha};
+use crate::chi2::{
+    chi2_test, chi2_test_sidak_sub, gamma_p, gamma_q, ln_gamma, pearson, sidak_alpha,
+};
 use crate::warp::{
     cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_sphere, uniform_hemisphere_pdf,
     uniform_sphere_pdf,
@@ -143,4 +145,37 @@ fn chi2_rejects_samples_outside_the_support() {
     // Non-unit vectors are reported, not binned.
     let err = chi2_test(51, 101, 10, 6, |_| Some(Vec3::splat(1.0)), |_| 0.0).unwrap_err();
     assert!(err.contains("not a unit vector"), "{err}");
+}
+
+#[test]
+fn finer_quadrature_integrates_a_jump_across_cells() {
+    // Uniform on a cap about a tilted axis: the pdf's jump (the cap's rim) crosses cells
+    // everywhere, not along their edges. 16 x 16 sub-cells per cell resolve it.
+    let frame = crate::Frame::from_z(Vec3::new(0.3, -0.5, 0.6).normalize());
+    let cos_max = 0.8f32;
+    let area = std::f64::consts::TAU * (1.0 - cos_max as f64);
+    let axis = frame.n;
+    chi2_test_sidak_sub(
+        1,
+        51,
+        100,
+        16,
+        400_000,
+        7,
+        |rng| {
+            let [u0, u1] = rng.uniform2();
+            let z = 1.0 - u0 * (1.0 - cos_max);
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let phi = std::f32::consts::TAU * u1;
+            Some(frame.to_world(Vec3::new(r * phi.cos(), r * phi.sin(), z)))
+        },
+        |w| {
+            if w.dot(axis) >= cos_max {
+                1.0 / area
+            } else {
+                0.0
+            }
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
 }
