@@ -264,7 +264,6 @@ illum 2
 newmtl lamp
 Kd 0 0 0
 Ka 10 10 10
-Ke 10 10 10
 ";
 
 const SCENE: &str = "\

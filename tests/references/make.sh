@@ -10,8 +10,8 @@
 #             OpenEXR, numpy); or PEERS_PYTHON=its python
 # VARIANT     Mitsuba variant, default llvm_ad_rgb (needs libLLVM >= 16); scalar_rgb is slower
 #             and draws different random numbers, so its images differ within noise
-# NAME        cornell-spheres-analytic, cornell-spheres-closeup, furnace, plane-light, corner
-#             (default: all)
+# NAME        cornell-spheres-analytic, cornell-spheres-closeup, cornell-glossy, cornell-rough,
+#             furnace, plane-light, corner (default: all)
 # `stats` prints the noise figures of the halves present (the tables of README.md).
 #
 # The scenes are read from scenes/*.toml of this repository (camera, and checks that the
@@ -34,10 +34,14 @@ TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 
 # Camera JSON (mitsuba_render.py's format) from a scene file's [camera], at W x H, after
-# checking the scene is still what the Mitsuba description assumes (KIND: obj | worksheet).
+# checking the scene is still what the Mitsuba description assumes (KIND: obj | worksheet |
+# obj-spheres). obj-spheres also writes the scene's spheres as the peers' spheres JSON
+# (OUT-spheres.json) with their materials in an MTL beside it: `metal` as a constant-Ks mirror
+# (illum 3), `dielectric` as glass (illum 7, Ni), `rough_conductor` and `rough_dielectric` as
+# the codes 13 and 14 that mitsuba_render_rough.py adds to the peers' mapping.
 camera() { # KIND SCENE.toml W H OUT.json
   "$PY" - "$PEERS" "$@" <<'EOF'
-import json, sys, tomllib
+import json, os, sys, tomllib
 peers, kind, src, w, h, out = sys.argv[1:]
 with open(src, "rb") as f:
     s = tomllib.load(f)
@@ -45,8 +49,33 @@ def need(ok, what):
     if not ok:
         sys.exit(f"{src}: {what}: the Mitsuba description in make.sh no longer matches")
 meshes, spheres, mats = s.get("mesh", []), s.get("sphere", []), s.get("material", {})
-if kind == "obj":  # one OBJ, untransformed, MTL materials with emission in Ke
-    need(len(meshes) == 1 and not spheres and not mats, "one mesh, no spheres, no [material]")
+if kind in ("obj", "obj-spheres"):  # one OBJ, untransformed, MTL materials with emission in Ke
+    if kind == "obj":
+        need(len(meshes) == 1 and not spheres and not mats, "one mesh, no spheres, no [material]")
+    else:
+        need(len(meshes) == 1 and spheres, "one mesh and spheres")
+        mtl, doc = [], {"mtllib": os.path.basename(out)[:-5] + "-spheres.mtl", "spheres": []}
+        for name, m in mats.items():
+            if m.get("type") == "metal":
+                r = m["reflectance"]
+                mtl.append(f"newmtl {name}\nKd 0 0 0\nKs {r[0]} {r[1]} {r[2]}\nillum 3\n")
+            elif m.get("type") == "dielectric":
+                mtl.append(f"newmtl {name}\nKd 0 0 0\nKs 1 1 1\nTf 1 1 1\nNi {m['ior']}\nillum 7\n")
+            elif m.get("type") == "rough_conductor" and "eta" not in m and "k" not in m:
+                r = m.get("reflectance", [1, 1, 1])
+                mtl.append(f"newmtl {name}\nKs {r[0]} {r[1]} {r[2]}\nNs {m['alpha']}\nillum 13\n")
+            elif m.get("type") == "rough_dielectric":
+                mtl.append(f"newmtl {name}\nNi {m['ior']}\nNs {m['alpha']}\nillum 14\n")
+            else:
+                need(False, f"material {name}: only metal, dielectric, rough_conductor (no eta, k) and rough_dielectric spheres")
+        for i, sp in enumerate(spheres):
+            need(sp["material"] in mats, "sphere " + sp["material"] + ": a [material] of the scene file")
+            doc["spheres"].append({"name": f"sphere_{i}", "material": sp["material"],
+                                   "center": sp["center"], "radius": sp["radius"]})
+        with open(out[:-5] + "-spheres.mtl", "w") as f:
+            f.write("\n".join(mtl))
+        with open(out[:-5] + "-spheres.json", "w") as f:
+            json.dump(doc, f)
     m = meshes[0]
     need(m.get("scale", 1.0) in (1, 1.0, [1, 1, 1]) and m.get("rotate", [0, 0, 0]) == [0, 0, 0]
          and m.get("translate", [0, 0, 0]) == [0, 0, 0], "no transform")
@@ -81,7 +110,7 @@ render() {
   for half in a b; do
     if [ $half = a ]; then seed=$SEED_A; else seed=$SEED_B; fi
     echo "== $name ${w}x$h half $half: seed $seed, $spp spp"
-    "$PY" "$PEERS/mitsuba_render.py" "$obj" "$@" --camera "$TMP/$name-${w}x$h.json" \
+    "$PY" "$HERE/mitsuba_render_rough.py" "$PEERS" "$obj" "$@" --camera "$TMP/$name-${w}x$h.json" \
       --width "$w" --height "$h" --spp "$spp" --spp-per-pass "$pp" --seed "$seed" \
       --integrator path --max-depth -1 --rr-depth 5 --sampler independent --rfilter box \
       --variant "$VARIANT" -o "$HERE/$name-${w}x$h-$half.exr"
@@ -127,12 +156,19 @@ EOF
 P=$PEERS/worksheet
 S=$REPO/scenes
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup furnace plane-light corner)
+[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough furnace plane-light corner)
 for n in "${names[@]}"; do
   case $n in
     cornell-spheres-analytic)
       render $n worksheet "$S/cornell-spheres/analytic.toml" 128 128 8192 1024 \
         "$P/cornell_worksheet_box.obj" --spheres "$P/cornell_worksheet_spheres.json" ;;
+    cornell-glossy)
+      # The floor is MTL illum 2: the peers' --glossy mapping (Lambertian Kd + GGX Ks).
+      render $n obj-spheres "$S/cornell-glossy/glossy-floor.toml" 128 128 8192 1024 \
+        "$S/cornell-glossy/box.obj" --spheres "$TMP/$n-128x128-spheres.json" --glossy ;;
+    cornell-rough)
+      render $n obj-spheres "$S/cornell-glossy/rough-spheres.toml" 128 128 8192 1024 \
+        "$S/cornell-glossy/box.obj" --spheres "$TMP/$n-128x128-spheres.json" --glossy ;;
     cornell-spheres-closeup)
       render $n worksheet "$S/cornell-spheres/closeup.toml" 128 128 8192 1024 \
         "$P/cornell_worksheet_box.obj" --spheres "$P/cornell_worksheet_spheres.json" ;;

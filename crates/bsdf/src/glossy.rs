@@ -43,8 +43,10 @@ impl Glossy {
         }
     }
 
+    /// The GGX lobe alone: what photon estimates, which read diffuse lobes only, leave to
+    /// be followed as a path.
     #[inline]
-    pub(crate) fn specular_lobe(&self) -> RoughConductor {
+    pub fn specular_lobe(&self) -> RoughConductor {
         RoughConductor {
             alpha: self.alpha,
             reflectance: self.specular,
@@ -69,6 +71,36 @@ impl Glossy {
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let pd = self.diffuse_probability();
         pd * self.diffuse().pdf(wo, wi) + (1.0 - pd) * self.specular_lobe().pdf(wo, wi)
+    }
+
+    /// One lobe, picked by `uc` with [`Glossy::diffuse_probability`], weighted by it alone:
+    /// `f` is that lobe's and `pdf` its density times the probability of picking it, so the
+    /// weight estimates that lobe's share and the two shares sum to the whole BSDF. The flag
+    /// is true for the diffuse lobe. Callers that must tell a diffuse-lobe path from a
+    /// glossy one use this (the path tracer's split with photon splatting).
+    pub fn sample_lobe(&self, wo: Vec3, uc: f32, u: [f32; 2]) -> Option<(BsdfSample, bool)> {
+        let pd = self.diffuse_probability();
+        if uc < pd {
+            let s = self.diffuse().sample(wo, u)?;
+            (pd > 0.0).then_some((
+                BsdfSample {
+                    pdf: s.pdf * pd,
+                    ..s
+                },
+                true,
+            ))
+        } else {
+            let s = self.specular_lobe().sample(wo, u)?;
+            let p = s.pdf * (1.0 - pd);
+            (p > 0.0).then_some((
+                BsdfSample {
+                    pdf: p,
+                    flags: Flags::GLOSSY_REFLECTION,
+                    ..s
+                },
+                false,
+            ))
+        }
     }
 
     /// `uc` picks the lobe; the sample then carries the whole `f` and the mixture pdf, so its

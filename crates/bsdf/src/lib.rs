@@ -216,6 +216,23 @@ impl Bsdf {
         matches!(self, Bsdf::Lambertian(_))
     }
 
+    /// [`Bsdf::sample`], but for the Glossy model one lobe alone ([`Glossy::sample_lobe`]);
+    /// the flag is true when the lobe sampled is diffuse (a Lambertian model's always).
+    pub fn sample_lobe(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: [f32; 2],
+        mode: TransportMode,
+    ) -> Option<(BsdfSample, bool)> {
+        match self {
+            Bsdf::Glossy(g) if wo.z != 0.0 => g.sample_lobe(wo, uc, u),
+            _ => self
+                .sample(wo, uc, u, mode)
+                .map(|s| (s, matches!(self, Bsdf::Lambertian(_)))),
+        }
+    }
+
     /// Albedo of the Lambertian lobe, if the model has one (Lambertian, and Glossy's base).
     pub fn diffuse_albedo(&self) -> Option<Vec3> {
         match self {

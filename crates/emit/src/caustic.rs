@@ -14,7 +14,7 @@
 
 use crate::diff::{emit_diff, mesh_dn, reflect_diff, refract_diff, sphere_dn, transfer};
 use crate::{EMIT_STREAM, EmitParams};
-use bsdf::Bsdf;
+use bsdf::{Bsdf, Lambertian};
 use geom::{Hit, Prim};
 use glam::Vec3;
 use math::Rng;
@@ -153,35 +153,65 @@ fn trace_one(
             }
         }
         if !bsdf.is_delta() {
-            // A diffuse hit: a caustic photon if the path so far is L S+ (D S*)*; the
-            // differentials mean something only at the first.
-            if specular_bounces == 0 && diffuse == 0 {
+            // A non-delta hit ends the specular chain from the light. Where the surface has
+            // a diffuse lobe this is a caustic photon if the path so far is L S+ (D S*)*
+            // (the differentials mean something only at the first); a glossy surface first
+            // (L S+ G) is the path tracer's, as L D is.
+            if diffuse == 0 && (specular_bounces == 0 || bsdf.diffuse_albedo().is_none()) {
                 return;
             }
-            diffuse += 1;
-            let first = diffuse == 1;
-            out.push(CausticPhoton {
-                position: hit.point.p,
-                normal: if d.dot(ng) < 0.0 { ng } else { -ng },
-                surface: surface_id(hit.prim),
-                flux,
-                a: if first { rd.dodu } else { Vec3::ZERO },
-                b: if first { rd.dodv } else { Vec3::ZERO },
-                path: index,
-                diffuse,
-            });
-            let (true, Bsdf::Lambertian(l)) = (indirect, bsdf) else {
-                return;
-            };
-            // The photon tracer's Russian roulette at a diffuse bounce (`trace_range`).
-            let survive = (l.albedo * flux).max_element() / flux.max_element();
-            if uc >= survive {
+            if bsdf.diffuse_albedo().is_some() {
+                diffuse += 1;
+                let first = diffuse == 1;
+                out.push(CausticPhoton {
+                    position: hit.point.p,
+                    normal: if d.dot(ng) < 0.0 { ng } else { -ng },
+                    surface: surface_id(hit.prim),
+                    flux,
+                    a: if first { rd.dodu } else { Vec3::ZERO },
+                    b: if first { rd.dodv } else { Vec3::ZERO },
+                    path: index,
+                    diffuse,
+                });
+            }
+            if !indirect {
                 return;
             }
-            flux = flux * l.albedo / survive;
-            let Some((wi, _)) = crate::trace::scatter(&hit, bsdf, d, uc, u) else {
+            // Leaving the caustic's own receiver, only its diffuse lobe carries the caustic
+            // on: light its glossy lobe sends on (L S+ G ...) is the path tracer's. So a
+            // Glossy surface goes on as its Lambertian part, chosen with its sampling
+            // probability (`uc` rescaled stays uniform for the roulette below).
+            let (bsdf, uc) = match bsdf {
+                Bsdf::Glossy(g) if diffuse == 1 => {
+                    let pd = g.diffuse_probability();
+                    if uc >= pd {
+                        return;
+                    }
+                    flux /= pd;
+                    (Bsdf::Lambertian(Lambertian { albedo: g.albedo }), uc / pd)
+                }
+                b => (b, uc),
+            };
+            // On past it as the photon tracer goes (`trace_range`): Russian roulette on the
+            // albedo at a Lambertian bounce, on the sample's weight at a glossy one.
+            if let Bsdf::Lambertian(l) = bsdf {
+                let survive = (l.albedo * flux).max_element() / flux.max_element();
+                if uc >= survive {
+                    return;
+                }
+                flux = flux * l.albedo / survive;
+            }
+            let Some((wi, s)) = crate::trace::scatter(&hit, bsdf, d, uc, u) else {
                 return;
             };
+            if !matches!(bsdf, Bsdf::Lambertian(_)) {
+                let kept = flux * s.weight();
+                let survive = (kept.max_element() / flux.max_element()).min(1.0);
+                if rng.uniform() >= survive || survive.is_nan() {
+                    return;
+                }
+                flux = kept / survive;
+            }
             ray = hit.point.spawn_ray(wi);
             continue;
         }

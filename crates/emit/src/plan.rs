@@ -101,6 +101,16 @@ impl Plan {
                 specular.join(", ")
             )
         });
+        let glossy = names(&|m, _| scene.bsdf(m).is_some_and(|b| b.is_glossy()));
+        if !glossy.is_empty() {
+            reasons.push(format!(
+                "glossy surfaces ({}): photons scatter off them by sampling the BSDF and are \
+                 stored only where there is a diffuse lobe; eye paths follow their GGX lobes \
+                 as paths (a glossy bounce ends a caustic chain: light it passes on is the \
+                 global map's and the path tracer's, not the caustic map's or the splats')",
+                glossy.join(", ")
+            ));
+        }
         if !global && !caustic {
             reasons.push("photon tracing: skipped (no photon set to fill)".to_string());
         }

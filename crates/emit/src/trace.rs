@@ -163,6 +163,7 @@ impl Tracer<'_> {
         let mut flux = e.flux.as_vec3();
         let mut ray = e.ray;
         let mut specular_bounces = 0u32;
+        // Non-delta bounces: a photon is a caustic photon only while it has made none.
         let mut diffuse_bounces = 0u32;
         for hit_index in 0..self.params.max_depth {
             // Black photons (a channel-less mirror, say) carry nothing; NaN fails this too.
@@ -177,7 +178,9 @@ impl Tracer<'_> {
                 return;
             };
             let d = ray.d.normalize();
-            if let Bsdf::Lambertian(Lambertian { albedo }) = bsdf {
+            // Photons are stored where a surface has a diffuse lobe (Lambertian, or the
+            // Glossy model's Lambertian part), the lobe photon estimates read.
+            if bsdf.diffuse_albedo().is_some() {
                 let photon = || Photon::new(hit.point.p, flux, d, surface_id(hit.prim));
                 if self.plan.global && (hit_index > 0 || self.params.store_direct) {
                     out.sets[MapKind::Global].push(photon());
@@ -185,17 +188,21 @@ impl Tracer<'_> {
                 if self.plan.caustic && specular_bounces > 0 && diffuse_bounces == 0 {
                     out.sets[MapKind::Caustic].push(photon());
                 }
-                // Past a diffuse bounce only the global set can gain photons; past the last
+            }
+            if !bsdf.is_delta() {
+                // Past a non-delta bounce only the global set can gain photons; past the last
                 // hit, nothing.
                 if !self.plan.global || hit_index + 1 == self.params.max_depth {
                     return;
                 }
+                diffuse_bounces += 1;
+            }
+            if let Bsdf::Lambertian(Lambertian { albedo }) = bsdf {
                 let survive = (albedo * flux).max_element() / flux.max_element();
                 if uc >= survive {
                     return;
                 }
                 flux = flux * albedo / survive;
-                diffuse_bounces += 1;
             }
             let Some((wi, s)) = scatter(&hit, bsdf, d, uc, u) else {
                 return;
@@ -203,6 +210,17 @@ impl Tracer<'_> {
             if s.is_specular() {
                 flux *= s.weight();
                 specular_bounces += 1;
+            } else if !matches!(bsdf, Bsdf::Lambertian(_)) {
+                // A glossy bounce: the sample's weight, then Russian roulette on the share
+                // of the flux it keeps (Jensen 2001 §5.3 for the diffuse case). Its number
+                // is drawn here, at glossy hits only, so scenes without them keep their
+                // streams.
+                let kept = flux * s.weight();
+                let survive = (kept.max_element() / flux.max_element()).min(1.0);
+                if rng.uniform() >= survive || survive.is_nan() {
+                    return;
+                }
+                flux = kept / survive;
             }
             ray = hit.point.spawn_ray(wi);
         }

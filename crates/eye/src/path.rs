@@ -111,6 +111,11 @@ impl<'a> PathTracer<'a> {
         let mut eta_scale = 1.0f32;
         // Non-delta vertices passed so far (the current one included once counted).
         let mut diffuse_vertices = 0u32;
+        // Bounces that sampled a diffuse lobe, and whether the last non-delta bounce did:
+        // a specular chain from a diffuse lobe to the light is what photon splatting owns
+        // (a caustic), from a glossy lobe the path tracer keeps it.
+        let mut diffuse_lobes = 0u32;
+        let mut last_lobe_diffuse = false;
         // Where the last bounce left and its BSDF pdf, if that bounce was non-delta: a light
         // hit then competes with NEE and is MIS-weighted. `None` after a specular bounce.
         let mut from_diffuse: Option<(Vec3, f32)> = None;
@@ -126,7 +131,11 @@ impl<'a> PathTracer<'a> {
                         let pdf_light = lights.pdf(light, p, hit.point.p);
                         let w = power_heuristic(1, pdf_bsdf, 1, pdf_light);
                         out.add(direct_or_indirect(diffuse_vertices), beta * le * w);
-                    } else if diffuse_vertices > 1 {
+                    } else if !last_lobe_diffuse {
+                        // Specular chain from a glossy lobe to the light (L S+ G ...): no
+                        // caustic photon ends on a glossy lobe, so the path tracer keeps it.
+                        out.add(direct_or_indirect(diffuse_vertices), beta * le);
+                    } else if diffuse_lobes > 1 {
                         // Specular chain from a diffuse vertex to the light: NEE's shadow
                         // rays cannot follow it, so BSDF sampling owns it (weight 1).
                         if self.opts.caustic_indirect {
@@ -172,7 +181,11 @@ impl<'a> PathTracer<'a> {
                 }
             }
 
-            let Some(s) = bsdf.sample(wo_l, u_lobe, u_dir, TransportMode::Radiance) else {
+            // One lobe at a time, weighted by it alone, so each path has one class (a
+            // Glossy surface's diffuse part is a caustic receiver, its GGX part not).
+            let Some((s, diffuse_lobe)) =
+                bsdf.sample_lobe(wo_l, u_lobe, u_dir, TransportMode::Radiance)
+            else {
                 break;
             };
             let wi = frame.to_world(s.wi);
@@ -183,10 +196,16 @@ impl<'a> PathTracer<'a> {
             if s.is_transmission() {
                 eta_scale *= s.eta * s.eta;
             }
+            if !s.is_specular() {
+                diffuse_lobes += diffuse_lobe as u32;
+                last_lobe_diffuse = diffuse_lobe;
+            }
+            // MIS against next-event estimation weighs the whole BSDF's density, the one
+            // NEE's own weight reads.
             from_diffuse = if s.is_specular() {
                 None
             } else {
-                Some((hit.point.p, s.pdf))
+                Some((hit.point.p, bsdf.pdf(wo_l, s.wi)))
             };
             ray = hit.point.spawn_ray(wi);
             bounces += 1;

@@ -131,7 +131,10 @@ impl Ctx<'_> {
             let ray = v.hit.point.spawn_ray(wi);
             // One Fresnel-chosen path per gather ray (no splits): its diffuse end, if any.
             let mut end = None;
-            first_diffuse(self.scene, ray, 0, rng, false, &mut |y| end = Some(y));
+            // Emission is returned only past a glossy bounce (L G+ X is no caustic and no
+            // light sample at the vertex reaches it).
+            let emitted = first_diffuse(self.scene, ray, 0, rng, false, &mut |y| end = Some(y));
+            sum += emitted.as_dvec3();
             if let Some(y) = end {
                 let e = self.maps.irradiance(MapLookup::Global, y.hit.point.p, y.n);
                 sum += (y.beta * y.albedo / std::f32::consts::PI * e).as_dvec3();

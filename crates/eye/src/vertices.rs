@@ -1,5 +1,5 @@
 //! Eye vertices: where camera paths first meet a diffuse surface after any number of specular
-//! bounces (E S* D), the points at which photon splatting (and SPPM's visible points)
+//! or glossy bounces (E (S|G)* D), the points at which photon splatting (and SPPM's visible points)
 //! estimate radiance. Through glass both reflection and refraction are followed, weighted by
 //! Fresnel, for the first few dielectric hits (the course framework's two splits), then one
 //! of them is chosen with Fresnel probability (Russian roulette), so 1-spp images through the
@@ -121,6 +121,10 @@ struct Branch {
     length: f32,
     depth: u32,
     splits: u32,
+    /// A glossy bounce was made on the way: emission met past it is counted whatever
+    /// `count_emission` says, since neither next-event estimation at the vertex the walk
+    /// started from nor a caustic map (specular chains only) holds it.
+    glossy: bool,
 }
 
 /// Most dielectric splits one walk follows: the branches waiting on the stack are never more
@@ -135,7 +139,8 @@ pub(crate) const MAX_SPLITS: u32 = 16;
 /// with Fresnel probability. Every hit draws three numbers from `rng` whether it uses them or
 /// not (the layout every eye pass shares), so without a split the walk is the single path
 /// the photon-map passes have always followed. Returns the emission met on the way, each
-/// light hit weighted by its branch's throughput, when `count_emission`.
+/// light hit weighted by its branch's throughput, when `count_emission` or past a glossy
+/// bounce.
 pub(crate) fn first_diffuse(
     scene: &Scene,
     ray: Ray,
@@ -155,6 +160,7 @@ pub(crate) fn first_diffuse(
         length: 0.0,
         depth: 0,
         splits: 0,
+        glossy: false,
     });
     let mut len = 1;
     while len > 0 {
@@ -168,7 +174,9 @@ pub(crate) fn first_diffuse(
         let Some(hit) = scene.geometry.intersect(&b.ray) else {
             continue;
         };
-        if count_emission && let Some(light) = lights.light_of(hit.prim) {
+        if (count_emission || b.glossy)
+            && let Some(light) = lights.light_of(hit.prim)
+        {
             emitted += b.beta * lights.le(light, b.ray.d);
         }
         let wo = -b.ray.d.normalize();
@@ -178,24 +186,47 @@ pub(crate) fn first_diffuse(
             continue;
         };
         let length = b.length + hit.t * b.ray.d.length();
-        if let Bsdf::Lambertian(l) = bsdf {
-            // Shading normals face the geometric one (geom), so this turns both to the side
-            // the ray came from.
-            let n = if wo.dot(hit.point.n) >= 0.0 {
+        // Shading normals face the geometric one (geom), so this turns both to the side the
+        // ray came from.
+        let facing = || {
+            if wo.dot(hit.point.n) >= 0.0 {
                 hit.ns
             } else {
                 -hit.ns
-            };
-            found(Found {
-                hit,
-                n,
-                albedo: l.albedo,
-                beta: b.beta,
-                length,
-                wo,
-            });
-            continue;
-        }
+            }
+        };
+        // Photon estimates read diffuse lobes only. The Glossy model's two lobes are chosen
+        // between with its sampling probability: its Lambertian part is a vertex, its GGX
+        // part is followed as a specular bounce is (pbrt-v4's SPPM follows glossy lobes too).
+        let (bsdf, lobe) = match bsdf {
+            Bsdf::Lambertian(l) => {
+                found(Found {
+                    hit,
+                    n: facing(),
+                    albedo: l.albedo,
+                    beta: b.beta,
+                    length,
+                    wo,
+                });
+                continue;
+            }
+            Bsdf::Glossy(g) => {
+                let pd = g.diffuse_probability();
+                if u_lobe < pd {
+                    found(Found {
+                        hit,
+                        n: facing(),
+                        albedo: g.albedo,
+                        beta: b.beta / pd,
+                        length,
+                        wo,
+                    });
+                    continue;
+                }
+                (Bsdf::from(g.specular_lobe()), 1.0 / (1.0 - pd))
+            }
+            other => (other, 1.0),
+        };
         let frame = Frame::from_z(hit.ns);
         let wo_l = frame.to_local(wo);
         let split = matches!(bsdf, Bsdf::Dielectric(_)) && b.splits < splits;
@@ -224,7 +255,7 @@ pub(crate) fn first_diffuse(
             if !sides_agree(wo, wi, hit.point.n, wo_l, s.wi) {
                 continue;
             }
-            let beta = b.beta * weight;
+            let beta = b.beta * weight * lobe;
             if beta == Vec3::ZERO || !beta.is_finite() {
                 continue;
             }
@@ -234,6 +265,7 @@ pub(crate) fn first_diffuse(
                 length,
                 depth: b.depth + 1,
                 splits: b.splits + split as u32,
+                glossy: b.glossy || !s.is_specular(),
             });
             len += 1;
         }

@@ -369,12 +369,16 @@ impl PhotonArgs {
 
 /// The one load of a command's scene, with `--seed` applied.
 fn load(path: &Path, seed: Option<u64>) -> Result<Scene, String> {
-    Scene::load_with(path, |f| {
+    let scene = Scene::load_with(path, |f| {
         if let Some(s) = seed {
             f.seed = s;
         }
     })
-    .map_err(|e| e.to_string())
+    .map_err(|e| e.to_string())?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(scene)
 }
 
 /// `render` and `estimate`: the one path through the library, then a summary line.

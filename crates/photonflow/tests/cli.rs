@@ -81,6 +81,40 @@ fn a_good_scene_exits_zero() {
     assert!(String::from_utf8_lossy(&out.stdout).contains("triangles  4"));
 }
 
+/// What a scene's MTL asks for and photonflow approximates is said on stderr, one `warning:`
+/// line per material and key, naming the file and material; the run still succeeds.
+#[test]
+fn approximated_mtl_keys_are_warned_about() {
+    let mtl = MTL.replace(
+        "Kd 0.5 0.5 0.5",
+        "Kd 0 0 0\nKs 0.9 0.9 0.9\nillum 5\nbump b.png",
+    );
+    let dir = Scratch::new(
+        "warned",
+        &[("s.toml", &toml()), ("a.obj", OBJ), ("m.mtl", &mtl)],
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_photonflow"))
+        .arg("info")
+        .arg(dir.0.join("s.toml"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let warnings: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("warning: "))
+        .collect();
+    assert_eq!(warnings.len(), 2, "{stderr}");
+    for key in ["illum 5", "bump b.png"] {
+        assert!(
+            warnings
+                .iter()
+                .any(|w| w.contains("m.mtl: material `white`: ") && w.contains(key)),
+            "no warning about {key}: {stderr}"
+        );
+    }
+}
+
 #[test]
 fn a_closed_stdout_ends_quietly_with_the_sigpipe_status() {
     let dir = Scratch::new(
@@ -136,7 +170,7 @@ fn bad_inputs_fail_cleanly() {
     check(
         "illum",
         &[("s.toml", &t), ("a.obj", OBJ), ("m.mtl", &illum)],
-        "a.obj",
+        "m.mtl",
         "unknown illum code 99",
     );
     let dark = MTL.replace("Ke 4 4 4", "");

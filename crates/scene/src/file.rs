@@ -280,6 +280,30 @@ pub enum MaterialDesc {
     Dielectric {
         ior: f32,
     },
+    /// A Lambertian `albedo` plus a GGX lobe of constant reflectance `specular` (no Fresnel)
+    /// and roughness `alpha`: MTL `illum 2` given directly.
+    Glossy {
+        albedo: [f32; 3],
+        specular: [f32; 3],
+        alpha: f32,
+    },
+    /// A rough metal (GGX, roughness `alpha`): reflectance `reflectance` times the Fresnel
+    /// term of the complex index `eta + i k` where both are given, else times 1 (Mitsuba 3's
+    /// `roughconductor`).
+    RoughConductor {
+        alpha: f32,
+        #[serde(default = "one3")]
+        reflectance: [f32; 3],
+        #[serde(default)]
+        eta: Option<[f32; 3]>,
+        #[serde(default)]
+        k: Option<[f32; 3]>,
+    },
+    /// Rough glass (GGX, roughness `alpha`) of index `ior` (Mitsuba 3's `roughdielectric`).
+    RoughDielectric {
+        ior: f32,
+        alpha: f32,
+    },
 }
 
 fn one3() -> [f32; 3] {

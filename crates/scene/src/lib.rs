@@ -27,7 +27,7 @@ pub use file::{
 };
 pub use lights::{Emitted, LightPoint, LightSample, LightTable};
 pub use load::{AreaLight, Scene, fnv1a64};
-pub use material::Material;
+pub use material::{ALPHA_RANGE, Material};
 pub use world::{SPHERE_BIT, bsdf_of, sides_agree, surface_id};
 
 #[cfg(test)]

@@ -13,6 +13,7 @@
 )]
 
 use crate::file::{EmissionSource, MaterialDesc, MeshDesc, NormalMode, Scale, SceneFile};
+use crate::material::ALPHA_RANGE;
 use crate::{Camera, LightTable, Material, RenderSettings, SceneError};
 use bsdf::Bsdf;
 use geom::{Geometry, Sphere, TriMesh, smooth_vertex_normals};
@@ -64,6 +65,9 @@ pub struct Scene {
     /// the seed or any sampling setting. Images with equal view hashes estimate the same
     /// picture and may be composited.
     pub view_hash: u64,
+    /// What the scene's files ask for that photonflow approximates, one line each (file,
+    /// material, what is drawn instead): commands print them as `warning:` lines.
+    pub warnings: Vec<String>,
 }
 
 impl Scene {
@@ -209,6 +213,7 @@ struct Builder<'a> {
     names: Vec<String>,
     emission: Vec<Vec3>,
     by_name: HashMap<String, u32>,
+    warnings: Vec<String>,
 }
 
 impl<'a> Builder<'a> {
@@ -227,6 +232,7 @@ impl<'a> Builder<'a> {
             names: Vec::new(),
             emission: Vec::new(),
             by_name: HashMap::new(),
+            warnings: Vec::new(),
         };
         // Scene-file materials first: they win over MTL materials of the same name.
         for (name, desc) in &file.materials {
@@ -252,6 +258,44 @@ impl<'a> Builder<'a> {
                 MaterialDesc::Dielectric { ior } => {
                     (Material::Dielectric { ior: *ior }, Vec3::ZERO)
                 }
+                MaterialDesc::Glossy {
+                    albedo,
+                    specular,
+                    alpha,
+                } => (
+                    Material::Glossy {
+                        albedo: Vec3::from(*albedo),
+                        specular: Vec3::from(*specular),
+                        alpha: *alpha,
+                    },
+                    Vec3::ZERO,
+                ),
+                MaterialDesc::RoughConductor {
+                    alpha,
+                    reflectance,
+                    eta,
+                    k,
+                } => (
+                    Material::RoughConductor {
+                        reflectance: Vec3::from(*reflectance),
+                        alpha: *alpha,
+                        // Both or neither: `validate_materials` refuses one alone.
+                        eta: match (eta, k) {
+                            (Some(e), Some(k)) => Some((Vec3::from(*e), Vec3::from(*k))),
+                            (Some(e), None) => Some((Vec3::from(*e), Vec3::NAN)),
+                            (None, Some(k)) => Some((Vec3::NAN, Vec3::from(*k))),
+                            (None, None) => None,
+                        },
+                    },
+                    Vec3::ZERO,
+                ),
+                MaterialDesc::RoughDielectric { ior, alpha } => (
+                    Material::RoughDielectric {
+                        ior: *ior,
+                        alpha: *alpha,
+                    },
+                    Vec3::ZERO,
+                ),
             };
             b.add_material(name, m, e);
         }
@@ -414,6 +458,7 @@ impl<'a> Builder<'a> {
             file,
             geometry: Geometry::new(self.mesh, self.spheres),
             bsdfs: self.materials.iter().map(crate::world::bsdf_of).collect(),
+            warnings: self.warnings,
             materials: self.materials,
             material_names: self.names,
             emission: self.emission,
@@ -435,10 +480,39 @@ impl<'a> Builder<'a> {
                     in_unit(*reflectance)
                 }
                 Material::Dielectric { ior } => ior.is_finite() && *ior > 0.0 && *ior < 10.0,
+                Material::Glossy {
+                    albedo,
+                    specular,
+                    alpha,
+                } => {
+                    in_unit(*albedo)
+                        && in_unit(*specular)
+                        && in_unit(*albedo + *specular)
+                        && ALPHA_RANGE.contains(alpha)
+                }
+                Material::RoughConductor {
+                    reflectance,
+                    alpha,
+                    eta,
+                } => {
+                    in_unit(*reflectance)
+                        && ALPHA_RANGE.contains(alpha)
+                        && eta.is_none_or(|(e, k)| {
+                            e.is_finite()
+                                && k.is_finite()
+                                && e.min_element() > 0.0
+                                && k.min_element() >= 0.0
+                        })
+                }
+                Material::RoughDielectric { ior, alpha } => {
+                    ior.is_finite() && *ior > 0.0 && *ior < 10.0 && ALPHA_RANGE.contains(alpha)
+                }
             };
             if !ok {
                 return Err(self.err(format!(
-                    "material `{name}`: albedo/reflectance must lie in [0, 1] and ior in (0, 10) (got {m:?})"
+                    "material `{name}`: albedo/reflectance (and albedo + specular) must lie in \
+                     [0, 1], ior in (0, 10), alpha in [1e-4, 1], eta > 0 and k >= 0 given \
+                     together (got {m:?})"
                 )));
             }
         }
@@ -473,6 +547,8 @@ impl<'a> Builder<'a> {
         let mtl_error: RefCell<Option<SceneError>> = RefCell::new(None);
         let mtl_bytes: RefCell<Vec<u8>> = RefCell::new(Vec::new());
         let mtl_files: RefCell<Vec<String>> = RefCell::new(Vec::new());
+        // Which MTL file defines which materials: problems name the file at fault.
+        let mtl_of: RefCell<Vec<(PathBuf, Vec<String>)>> = RefCell::new(Vec::new());
         let loaded = tobj::load_obj_buf(
             &mut BufReader::new(&bytes[..]),
             // Faces come whole and are triangulated here (`polygon`): tobj's fan is wrong for
@@ -499,12 +575,17 @@ impl<'a> Builder<'a> {
                                 return Err(tobj::LoadError::MaterialParseError);
                             }
                         };
-                        tobj::load_mtl_buf(&mut BufReader::new(&b[..])).inspect_err(|e| {
-                            *mtl_error.borrow_mut() = Some(SceneError::new(
-                                &mtl_path,
-                                format!("malformed MTL file: {e} ({of})"),
-                            ));
-                        })
+                        tobj::load_mtl_buf(&mut BufReader::new(&b[..]))
+                            .inspect(|(mats, _)| {
+                                let names = mats.iter().map(|m| m.name.clone()).collect();
+                                mtl_of.borrow_mut().push((mtl_path.clone(), names));
+                            })
+                            .inspect_err(|e| {
+                                *mtl_error.borrow_mut() = Some(SceneError::new(
+                                    &mtl_path,
+                                    format!("malformed MTL file: {e} ({of})"),
+                                ));
+                            })
                     }
                     Err(e) => {
                         *mtl_error.borrow_mut() = Some(SceneError::new(
@@ -530,13 +611,22 @@ impl<'a> Builder<'a> {
 
         // MTL materials → ids (scene-file materials of the same name win).
         let mut mat_ids = Vec::with_capacity(materials.len());
+        let defined_in = mtl_of.into_inner();
         for m in &materials {
             let id = match self.by_name.get(&m.name) {
                 Some(&id) => id,
                 None => {
-                    let (mat, e) = convert_mtl(m, desc.emission)
-                        .map_err(|p| oerr(format!("material `{}`: {p}", m.name)))?;
-                    self.add_material(&m.name, mat, e)
+                    let mtl = defined_in
+                        .iter()
+                        .rev()
+                        .find(|(_, names)| names.contains(&m.name))
+                        .map_or(obj_path.clone(), |(p, _)| p.clone());
+                    let at = |p: String| format!("{}: material `{}`: {p}", mtl.display(), m.name);
+                    let c = convert_mtl(m, desc.emission).map_err(|p| {
+                        SceneError::new(&mtl, format!("material `{}`: {p}", m.name))
+                    })?;
+                    self.warnings.extend(c.warnings.into_iter().map(at));
+                    self.add_material(&m.name, c.material, c.emission)
                 }
             };
             mat_ids.push(id);
@@ -779,36 +869,261 @@ fn in_unit(v: Vec3) -> bool {
     v.is_finite() && v.min_element() >= 0.0 && v.max_element() <= 1.0
 }
 
-/// The MTL → material mapping of `Material`'s docs.
-fn convert_mtl(m: &tobj::Material, emission: EmissionSource) -> Result<(Material, Vec3), String> {
+/// An MTL material turned into one of photonflow's: the material, its emission, and a line
+/// for each thing it approximates (printed as `warning:` lines).
+struct Converted {
+    material: Material,
+    emission: Vec3,
+    warnings: Vec<String>,
+}
+
+/// MTL keys that change a surface's look but that photonflow does not read: a file that sets
+/// one is refused (`error`) or warned about (`warning`), never silently drawn otherwise.
+const UNREAD_KEYS: [(&str, &str); 12] = [
+    ("Pr", "error"),
+    ("Pm", "error"),
+    ("Ps", "error"),
+    ("Pc", "error"),
+    ("Pcr", "error"),
+    ("aniso", "error"),
+    ("anisor", "error"),
+    ("map_Pr", "error"),
+    ("map_Pm", "error"),
+    ("refl", "warning"),
+    ("disp", "warning"),
+    ("decal", "warning"),
+];
+
+/// The MTL → material mapping of the table in `Material`'s docs (the MTL spec's `illum`
+/// models, the course framework's `illum 11` metal and `Ka` emission). `Err` is one line
+/// naming the key at fault.
+fn convert_mtl(m: &tobj::Material, emission: EmissionSource) -> Result<Converted, String> {
     let v = |a: Option<[f32; 3]>| a.map(Vec3::from).unwrap_or(Vec3::ZERO);
     let kd = v(m.diffuse);
-    let ks = m.specular.map(Vec3::from).unwrap_or(Vec3::ONE);
+    let mut warnings = Vec::new();
     let e = match emission {
         EmissionSource::Ke => v(m.emissive),
-        EmissionSource::Ka => v(m.ambient),
+        EmissionSource::Ka => {
+            if let Some(ke) = m.emissive.filter(|k| k.iter().any(|&c| c != 0.0)) {
+                return Err(format!(
+                    "`Ke {} {} {}` is not read: the scene file reads emission from `Ka` \
+                     (emission = \"ka\"); drop `Ke`, or set emission = \"ke\" and move the \
+                     emission there",
+                    ke[0], ke[1], ke[2]
+                ));
+            }
+            v(m.ambient)
+        }
     };
-    let ni = m.optical_density.unwrap_or(1.0);
-    let transparent = m.dissolve.is_some_and(|d| d < 1.0);
-    let mat = match m.illumination_model {
-        None | Some(0..=2) if transparent && ni > 1.0 => Material::Dielectric { ior: ni },
-        None | Some(0..=2) => Material::Lambertian { albedo: kd },
-        Some(3) => Material::Mirror { reflectance: ks },
-        Some(4 | 6 | 7) => Material::Dielectric { ior: ni },
-        Some(11) => Material::Metal { reflectance: ks },
-        Some(c @ (5 | 8 | 9 | 10 | 12 | 13 | 14)) => {
+    // `Tr` is `1 - d` (some exporters write one, some the other).
+    let tr = match m.unknown_param.get("Tr") {
+        Some(t) => Some(
+            t.trim()
+                .parse::<f32>()
+                .map_err(|_| format!("`Tr {t}`: not a number"))?,
+        ),
+        None => None,
+    };
+    let opacity = m.dissolve.or(tr.map(|t| 1.0 - t)).unwrap_or(1.0);
+    if !(0.0..=1.0).contains(&opacity) {
+        return Err(format!("`d`/`Tr`: opacity {opacity} must lie in [0, 1]"));
+    }
+    let tf_text = m.unknown_param.get("Tf").map_or("", String::as_str);
+    let tf = match m.unknown_param.get("Tf") {
+        Some(t) => {
+            let c: Vec<f32> = t
+                .split_whitespace()
+                .filter_map(|w| w.parse().ok())
+                .collect();
+            match c.as_slice() {
+                &[r, g, b] if t.split_whitespace().count() == 3 => Some(Vec3::new(r, g, b)),
+                _ => {
+                    return Err(format!(
+                        "`Tf {t}`: needs three numbers (an RGB transmission filter)"
+                    ));
+                }
+            }
+        }
+        None => None,
+    };
+    for (key, severity) in UNREAD_KEYS {
+        if let Some(val) = m.unknown_param.get(key) {
+            let what = format!("`{key} {val}`: photonflow does not read this key");
+            if severity == "error" {
+                return Err(what);
+            }
+            warnings.push(format!("{what}; the surface is drawn without it"));
+        }
+    }
+    for (key, tex) in [
+        ("map_Kd", &m.diffuse_texture),
+        ("map_Ks", &m.specular_texture),
+        ("map_d", &m.dissolve_texture),
+    ] {
+        if let Some(t) = tex {
             return Err(format!(
-                "illum {c} is a valid MTL code that photonflow does not render \
-                 (supported: 0-2 diffuse, 3 mirror, 4/6/7 glass, 11 metal)"
+                "`{key} {t}`: texture maps are not rendered yet; remove the line to draw the \
+                 material's constant colour"
             ));
         }
+    }
+    for (key, tex) in [
+        ("bump", &m.normal_texture),
+        ("map_Ns", &m.shininess_texture),
+    ] {
+        if let Some(t) = tex {
+            warnings.push(format!(
+                "`{key} {t}`: not rendered; the surface is drawn without it"
+            ));
+        }
+    }
+    let ni = m.optical_density;
+    let ks_given = m.specular.map(Vec3::from);
+    let ks = ks_given.unwrap_or(Vec3::ZERO);
+    let illum = m.illumination_model;
+    let glass_illum = matches!(illum, Some(4 | 6 | 7 | 9));
+    // The course's convention: `Ni > 1` on a partly transparent material without an `illum`
+    // that says otherwise is glass.
+    let course_glass =
+        matches!(illum, None | Some(0..=2)) && opacity < 1.0 && ni.is_some_and(|n| n > 1.0);
+    if opacity < 1.0 && !(glass_illum || course_glass) {
+        return Err(format!(
+            "opacity {opacity} (`d`/`Tr`): partly transparent surfaces are rendered only as \
+             glass (illum 4, 6, 7 or 9 with `Ni`)"
+        ));
+    }
+    if tf.is_some_and(|t| t != Vec3::ONE) {
+        if glass_illum || course_glass {
+            return Err(format!(
+                "`Tf {}`: coloured glass is not rendered yet",
+                tf_text
+            ));
+        }
+        warnings.push(format!(
+            "`Tf {}`: a transmission filter is read only for glass; illum {} is opaque",
+            tf_text,
+            illum.map_or("(none)".to_string(), |c| c.to_string())
+        ));
+    }
+    let mirror = |warnings: &mut Vec<String>, why: &str| {
+        if !why.is_empty() {
+            warnings.push(why.to_string());
+        }
+        if kd.max_element() > 0.0 {
+            warnings.push(format!(
+                "`Kd {} {} {}` is not used: illum {} draws a mirror of reflectance `Ks`",
+                kd.x,
+                kd.y,
+                kd.z,
+                illum.unwrap_or(0)
+            ));
+        }
+        // The peers' mapping: `Ks`, or a perfect mirror where `Ks` is absent or black.
+        let reflectance = if ks.max_element() > 0.0 {
+            ks
+        } else {
+            Vec3::ONE
+        };
+        Material::Mirror { reflectance }
+    };
+    let glass = |warnings: &mut Vec<String>, why: &str| {
+        if !why.is_empty() {
+            warnings.push(why.to_string());
+        }
+        let ior = match ni {
+            Some(n) if n > 1.0 => n,
+            _ => {
+                warnings.push(format!(
+                    "glass without an index above 1 (`Ni {}`): drawn with index 1.5",
+                    ni.map_or("absent".to_string(), |n| n.to_string())
+                ));
+                1.5
+            }
+        };
+        if ks_given.is_some_and(|k| k != Vec3::ONE) {
+            warnings.push(format!(
+                "`Ks {} {} {}` is not used: glass reflects by the Fresnel equations",
+                ks.x, ks.y, ks.z
+            ));
+        }
+        Material::Dielectric { ior }
+    };
+    let mat = match illum {
+        _ if course_glass => glass(&mut warnings, ""),
+        Some(2) if ks.max_element() > 0.0 => {
+            let ns = m.shininess.unwrap_or(0.0);
+            if !(ns.is_finite() && ns >= 0.0) {
+                return Err(format!("`Ns {ns}`: the Phong exponent must be >= 0"));
+            }
+            let (g, scaled) = bsdf::Glossy::from_mtl(kd, ks, ns);
+            if scaled {
+                warnings.push(format!(
+                    "`Kd` + `Ks` exceeds 1 in a channel ({} {} {}): both scaled there to sum \
+                     to 1",
+                    kd.x + ks.x,
+                    kd.y + ks.y,
+                    kd.z + ks.z
+                ));
+            }
+            Material::Glossy {
+                albedo: g.albedo,
+                specular: g.specular,
+                alpha: g.alpha,
+            }
+        }
+        None | Some(0..=2) => {
+            if ks.max_element() > 0.0 {
+                warnings.push(format!(
+                    "`Ks {} {} {}` is not drawn: only illum 2 turns on the specular term \
+                     (illum {})",
+                    ks.x,
+                    ks.y,
+                    ks.z,
+                    illum.map_or("absent".to_string(), |c| c.to_string())
+                ));
+            }
+            Material::Lambertian { albedo: kd }
+        }
+        Some(3) => mirror(&mut warnings, ""),
+        Some(5) => mirror(
+            &mut warnings,
+            "illum 5 (Fresnel reflection): drawn as a mirror of constant reflectance `Ks`",
+        ),
+        Some(8) => mirror(
+            &mut warnings,
+            "illum 8 (reflection without ray tracing): drawn as a ray-traced mirror",
+        ),
+        Some(4 | 7) => glass(&mut warnings, ""),
+        Some(6) => glass(
+            &mut warnings,
+            "illum 6 (refraction, Fresnel off): drawn as glass with Fresnel reflection",
+        ),
+        Some(9) => glass(
+            &mut warnings,
+            "illum 9 (glass without ray-traced reflection): drawn as glass with Fresnel \
+             reflection",
+        ),
+        Some(10) => {
+            return Err(
+                "illum 10 (a shadow matte: shadows cast onto invisible surfaces) \
+                        is not rendered"
+                    .into(),
+            );
+        }
+        Some(11) => Material::Metal {
+            reflectance: ks_given.unwrap_or(Vec3::ONE),
+        },
         Some(c) => {
             return Err(format!(
-                "unknown illum code {c} (supported: 0-2 diffuse, 3 mirror, 4/6/7 glass, 11 metal)"
+                "unknown illum code {c} (the MTL spec's 0-10 and the course's 11 metal)"
             ));
         }
     };
-    Ok((mat, e))
+    Ok(Converted {
+        material: mat,
+        emission: e,
+        warnings,
+    })
 }
 
 /// Scale, then rotate about x, y, z (degrees), then translate. Built in f64 with entries that

@@ -2,22 +2,72 @@ use glam::Vec3;
 
 /// What a surface does with light. Plain data: the eye and photon passes turn it into BSDFs.
 ///
-/// MTL mapping (the course framework's conventions; `load.rs` applies it): `Kd` → [`Material::Lambertian`];
-/// `illum 3` → [`Material::Mirror`] with `Ks`; `illum 4`, `6`, `7`, or `Ni > 1` on a
-/// transparent (`d < 1`) material → [`Material::Dielectric`] with `Ni`; `illum 11` →
-/// [`Material::Metal`] with reflectance `Ks` (the course's constant-reflectance model).
+/// MTL files map to materials by this table (`load.rs` applies it; the README repeats it).
+/// What photonflow cannot draw is refused with an error naming the MTL file, the material
+/// and the key; what it approximates is said in one warning line per material and key.
+///
+/// | MTL | material |
+/// |---|---|
+/// | `illum 0`, `1`, no `illum` | [`Material::Lambertian`] of `Kd` (a `Ks` is not drawn: warning) |
+/// | `illum 2` | Lambertian `Kd`, plus with `Ks > 0` a GGX lobe of reflectance `Ks`, no Fresnel, α = √(2 / (`Ns` + 2)) ([`Material::Glossy`]; `Kd + Ks > 1` in a channel scales both there: warning) |
+/// | `illum 3`, `5`, `8` | [`Material::Mirror`] of `Ks` (1 where `Ks` is absent or black); 5's Fresnel and 8's "no ray tracing" are not modelled (warning), nor a `Kd` (warning) |
+/// | `illum 4`, `6`, `7`, `9` | [`Material::Dielectric`] of index `Ni` (1.5 where `Ni` <= 1 or absent: warning); exact Fresnel (6 and 9 ask otherwise: warning) |
+/// | `illum 10` | refused (shadow matte) |
+/// | `illum 11` | [`Material::Metal`] of `Ks` (the course's constant-reflectance metal) |
+/// | `d < 1` or `Tr > 0` | glass with illum 4, 6, 7, 9, or illum 0-2 with `Ni > 1` (the course's glass); refused on any other surface |
+/// | `Ke` | emission (`emission = "ke"`, the default) |
+/// | `Ka` | emission with `emission = "ka"` (the course's convention; a `Ke` too is refused), else the ambient colour, which a physically based renderer has no use for |
+/// | `Tf` | refused on glass (coloured glass: not yet), warning elsewhere |
+/// | `map_Kd`, `map_Ks`, `map_d` | refused (textures: not yet) |
+/// | `bump`, `map_Bump`, `map_Ns`, `refl`, `disp`, `decal` | warning: drawn without |
+/// | `Pr`, `Pm`, `Ps`, `Pc`, `Pcr`, `aniso`, `anisor`, `map_Pr`, `map_Pm` (PBR extension) | refused |
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {
-    Lambertian { albedo: Vec3 },
-    Mirror { reflectance: Vec3 },
-    Metal { reflectance: Vec3 },
-    Dielectric { ior: f32 },
+    Lambertian {
+        albedo: Vec3,
+    },
+    Mirror {
+        reflectance: Vec3,
+    },
+    Metal {
+        reflectance: Vec3,
+    },
+    Dielectric {
+        ior: f32,
+    },
+    /// MTL `illum 2` with `Ks > 0`: Lambertian `albedo` plus a GGX lobe of constant
+    /// reflectance `specular` and roughness `alpha` ([`bsdf::Glossy`]).
+    Glossy {
+        albedo: Vec3,
+        specular: Vec3,
+        alpha: f32,
+    },
+    /// A rough metal: GGX of roughness `alpha`, reflectance times the Fresnel term of the
+    /// complex index `eta` (`(eta, k)`) where given ([`bsdf::RoughConductor`]).
+    RoughConductor {
+        reflectance: Vec3,
+        alpha: f32,
+        eta: Option<(Vec3, Vec3)>,
+    },
+    /// Rough glass: GGX of roughness `alpha` ([`bsdf::RoughDielectric`]).
+    RoughDielectric {
+        ior: f32,
+        alpha: f32,
+    },
 }
+
+/// Roughness a microfacet lobe may have: below it the lobe is a mirror in all but name
+/// (Mitsuba 3 and pbrt-v4 switch to the smooth model near 1e-4), above it the single-scattering
+/// GGX model loses most of its energy.
+pub const ALPHA_RANGE: std::ops::RangeInclusive<f32> = 1e-4..=1.0;
 
 impl Material {
     /// True for the delta (perfectly specular) materials: photons bounce off them and are
     /// never stored there; a path through them to a diffuse surface is a caustic path.
     pub fn is_specular(&self) -> bool {
-        !matches!(self, Material::Lambertian { .. })
+        matches!(
+            self,
+            Material::Mirror { .. } | Material::Metal { .. } | Material::Dielectric { .. }
+        )
     }
 }

@@ -4,7 +4,7 @@
 //! disagree about a material.
 
 use crate::{Material, Scene};
-use bsdf::{Bsdf, Dielectric, Lambertian, Metal, Mirror};
+use bsdf::{Bsdf, Dielectric, Glossy, Lambertian, Metal, Mirror, RoughConductor, RoughDielectric};
 use geom::Prim;
 use glam::Vec3;
 
@@ -21,6 +21,33 @@ pub fn bsdf_of(m: &Material) -> Option<Bsdf> {
         Material::Mirror { reflectance } => Some(Mirror { reflectance }.into()),
         Material::Metal { reflectance } => Some(Metal { reflectance }.into()),
         Material::Dielectric { ior } => Some(Dielectric { eta: ior }.into()),
+        Material::Glossy {
+            albedo,
+            specular,
+            alpha,
+        } => Some(
+            Glossy {
+                albedo,
+                specular,
+                alpha,
+            }
+            .into(),
+        ),
+        Material::RoughConductor {
+            reflectance,
+            alpha,
+            eta,
+        } => Some(
+            RoughConductor {
+                alpha,
+                reflectance,
+                eta,
+            }
+            .into(),
+        ),
+        Material::RoughDielectric { ior, alpha } => {
+            Some(RoughDielectric { eta: ior, alpha }.into())
+        }
     }
 }
 
@@ -52,11 +79,14 @@ impl Scene {
         self.bsdfs[material as usize]
     }
 
-    /// Diffuse: a non-delta BSDF that reflects something. Photons are stored on diffuse
-    /// surfaces, and photon-map eye passes estimate there; black surfaces are not diffuse.
+    /// Diffuse: a BSDF with a diffuse lobe (Lambertian, or the Glossy model's Lambertian
+    /// part) that reflects something. Photons are stored on diffuse surfaces, and photon-map
+    /// eye passes estimate there; black, specular and purely glossy surfaces are not diffuse.
     #[inline]
     pub fn is_diffuse(&self, material: u32) -> bool {
-        self.bsdfs[material as usize].is_some_and(|b| !b.is_delta())
+        self.bsdfs[material as usize]
+            .and_then(|b| b.diffuse_albedo())
+            .is_some_and(|a| a.max_element() > 0.0)
     }
 
     /// Unit geometric normal of surface `id` (see [`surface_id`]) at a point `p` on it, or
