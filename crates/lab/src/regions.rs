@@ -15,6 +15,14 @@ fn receives(scene: &Scene, material: u32) -> bool {
     scene.is_diffuse(material) && scene.emission[material as usize] == Vec3::ZERO
 }
 
+/// Glass, smooth or rough.
+fn is_glass(m: &Material) -> bool {
+    matches!(
+        m,
+        Material::Dielectric { .. } | Material::RoughDielectric { .. }
+    )
+}
+
 /// The named regions of an image of `scene`, from its geometry: the caustic under the glass
 /// sphere, the inner edges and corners of the box, its outer rim (the open front), the glass
 /// sphere, the open walls (diffuse surfaces away from edges and caustics), and the whole
@@ -36,12 +44,7 @@ pub fn regions(scene: &Scene) -> Vec<(&'static str, Mask)> {
             .intersect(&scene.camera.ray(x as f32 + 0.5, y as f32 + 0.5))
     };
     let glass = Mask::from_fn(w, h, |x, y| {
-        seen(x, y).is_some_and(|hit| {
-            matches!(
-                scene.materials[hit.material as usize],
-                Material::Dielectric { .. }
-            )
-        })
+        seen(x, y).is_some_and(|hit| is_glass(&scene.materials[hit.material as usize]))
     });
     let walls = Mask::from_fn(w, h, |x, y| {
         let i = y * w + x;
@@ -96,12 +99,7 @@ pub fn caustic_region(scene: &Scene, radii: f32) -> Mask {
         .geometry
         .spheres()
         .iter()
-        .filter(|s| {
-            matches!(
-                scene.materials[s.material as usize],
-                Material::Dielectric { .. }
-            )
-        })
+        .filter(|s| is_glass(&scene.materials[s.material as usize]))
         .map(|s| (s.center, s.radius))
         .collect();
     Mask::from_fn(w, h, |x, y| {
