@@ -586,9 +586,9 @@ const CLOSEUP_SPPM_16: Measured<6> = Measured {
     sd: [0.0032, 0.0092, 0.0009, 0.0015, 0.1053, 0.0029],
 };
 
-/// One image of the close-up by `method` at `count` samples per pixel (path, path+splat) or
-/// passes (SPPM).
-fn closeup_image(s: &Scene, method: Method, count: u32) -> Image {
+/// One image of `s` by `method` at `count` samples per pixel (path, path+splat) or passes
+/// (SPPM).
+fn image_by(s: &Scene, method: Method, count: u32) -> Image {
     let o = Overrides {
         method: Some(method),
         spp: (method != Method::Sppm).then_some(count),
@@ -598,21 +598,32 @@ fn closeup_image(s: &Scene, method: Method, count: u32) -> Image {
     sum_layers(&render_uncached(s, &o, None), |_| true)
 }
 
+/// The misfits of each run's image of `s` (method, count, its table) against `regs`.
+fn misfits_of_runs<const N: usize>(
+    s: &Scene,
+    regs: &[RegionRef],
+    runs: &[(Method, u32, &Measured<N>)],
+) -> Vec<String> {
+    let mut bad = Vec::new();
+    for &(method, count, table) in runs {
+        eprintln!("{method:?}, {count}:");
+        bad.extend(misfits(&image_by(s, method, count), regs, table));
+    }
+    bad
+}
+
 /// The refraction of the glass sphere as Mitsuba renders it: the light seen through it and
 /// the caustic's focus, by the path tracer, the path tracer with splatted caustics, and SPPM.
 #[test]
 fn the_glass_sphere_close_up_matches_mitsuba() {
     let s = closeup(1, |_| {});
     let regs = closeup_regions(&s);
-    let mut bad = Vec::new();
-    for (method, count, table) in [
+    let runs = [
         (Method::Path, 256, &CLOSEUP_PATH_256),
         (Method::PathSplat, 64, &CLOSEUP_PATH_SPLAT_64),
         (Method::Sppm, 16, &CLOSEUP_SPPM_16),
-    ] {
-        eprintln!("{method:?}, {count}:");
-        bad.extend(misfits(&closeup_image(&s, method, count), &regs, table));
-    }
+    ];
+    let bad = misfits_of_runs(&s, &regs, &runs);
     assert!(bad.is_empty(), "{bad:#?}");
 }
 
@@ -632,7 +643,7 @@ fn the_close_up_catches_a_glass_of_index_1_45() {
         (Method::PathSplat, 64, &CLOSEUP_PATH_SPLAT_64),
     ] {
         eprintln!("{method:?}, {count}, index 1.45:");
-        let bad = misfits(&closeup_image(&s, method, count), &regs, table);
+        let bad = misfits(&image_by(&s, method, count), &regs, table);
         assert!(
             bad.iter().any(|m| m.starts_with("light through glass:")),
             "{method:?}: a glass of index 1.45 passed: {bad:#?}"
@@ -694,18 +705,6 @@ const GLOSSY_SPPM_16: Measured = Measured {
     sd: [0.0050, 0.0182, 0.0017, 0.0319, 0.0309, 0.0029, 0.0540],
 };
 
-/// One image of the glossy-floor scene by `method` at `count` samples per pixel (path,
-/// path+splat) or passes (SPPM).
-fn glossy_image(s: &Scene, method: Method, count: u32) -> Image {
-    let o = Overrides {
-        method: Some(method),
-        spp: (method != Method::Sppm).then_some(count),
-        passes: (method == Method::Sppm).then_some(count),
-        ..Overrides::default()
-    };
-    sum_layers(&render_uncached(s, &o, None), |_| true)
-}
-
 /// A glossy receiver under the glass sphere (MTL `illum 2`: Lambertian plus GGX): the path
 /// tracer, the path tracer with splatted caustics and SPPM each match Mitsuba in every
 /// region, the caustic on the glossy floor included. Drawn without its GGX lobe (what
@@ -714,15 +713,12 @@ fn glossy_image(s: &Scene, method: Method, count: u32) -> Image {
 fn a_glossy_receiver_matches_mitsuba() {
     let s = glossy(1, |_| {});
     let regs = glossy_regions(&s);
-    let mut bad = Vec::new();
-    for (method, count, table) in [
+    let runs = [
         (Method::Path, 256, &GLOSSY_PATH_256),
         (Method::PathSplat, 256, &GLOSSY_PATH_SPLAT_256),
         (Method::Sppm, 16, &GLOSSY_SPPM_16),
-    ] {
-        eprintln!("{method:?}, {count}:");
-        bad.extend(misfits(&glossy_image(&s, method, count), &regs, table));
-    }
+    ];
+    let bad = misfits_of_runs(&s, &regs, &runs);
     assert!(bad.is_empty(), "{bad:#?}");
     let lambertian = glossy(1, |f| {
         f.materials.insert(
@@ -735,7 +731,7 @@ fn a_glossy_receiver_matches_mitsuba() {
     });
     eprintln!("path, 256, the floor without its GGX lobe:");
     let bad = misfits(
-        &glossy_image(&lambertian, Method::Path, 256),
+        &image_by(&lambertian, Method::Path, 256),
         &regs,
         &GLOSSY_PATH_256,
     );
@@ -784,14 +780,11 @@ fn rough_spheres_match_mitsuba() {
     let core = ("caustic core", lab::regions::caustic_region(&s, 0.8));
     let masks = lab::regions::regions(&s).into_iter().chain([core]);
     let regs = region_refs("cornell-rough", masks.collect());
-    let mut bad = Vec::new();
-    for (method, count, table) in [
+    let runs = [
         (Method::Path, 256, &ROUGH_PATH_256),
         (Method::Sppm, 16, &ROUGH_SPPM_16),
-    ] {
-        eprintln!("{method:?}, {count}:");
-        bad.extend(misfits(&glossy_image(&s, method, count), &regs, table));
-    }
+    ];
+    let bad = misfits_of_runs(&s, &regs, &runs);
     assert!(bad.is_empty(), "{bad:#?}");
     let smooth = rough(1, |f| {
         f.materials.insert(
@@ -805,7 +798,7 @@ fn rough_spheres_match_mitsuba() {
     });
     eprintln!("path, 256, smooth spheres:");
     let bad = misfits(
-        &glossy_image(&smooth, Method::Path, 256),
+        &image_by(&smooth, Method::Path, 256),
         &regs,
         &ROUGH_PATH_256,
     );

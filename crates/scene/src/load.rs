@@ -487,7 +487,8 @@ impl<'a> Builder<'a> {
                 } => {
                     in_unit(*albedo)
                         && in_unit(*specular)
-                        && in_unit(*albedo + *specular)
+                        // MTL's scaling to a sum of 1 may round a hair above it.
+                        && in_unit((*albedo + *specular) / (1.0 + 1e-6))
                         && ALPHA_RANGE.contains(alpha)
                 }
                 Material::RoughConductor {
@@ -1068,7 +1069,9 @@ fn convert_mtl(m: &tobj::Material, emission: EmissionSource) -> Result<Converted
             Material::Glossy {
                 albedo: g.albedo,
                 specular: g.specular,
-                alpha: g.alpha,
+                // A Phong exponent past 2e8 would be a mirror: the smallest roughness
+                // the GGX models take.
+                alpha: g.alpha.max(*ALPHA_RANGE.start()),
             }
         }
         None | Some(0..=2) => {

@@ -809,6 +809,19 @@ fn mtl_files_follow_the_documented_table() {
         panic!("not glossy")
     };
     assert!((albedo.x - 0.66 / 1.56).abs() < 1e-6 && (specular.x - 0.9 / 1.56).abs() < 1e-6);
+    // Scaled sums that round a hair above 1 still load; a mirror-like exponent takes the
+    // smallest roughness.
+    for (kd, ks) in [
+        ("0.66 0.33 0.1", "0.9 0.8 0.95"),
+        ("0.7 0.61 0.57", "0.31 0.77 0.83"),
+    ] {
+        warned(&format!("Kd {kd}\nKs {ks}\nNs 10\nillum 2"), "exceeds 1");
+    }
+    let Material::Glossy { alpha, .. } = quiet("Kd 0.3 0.3 0.3\nKs 0.7 0.7 0.7\nNs 1e12\nillum 2")
+    else {
+        panic!("not glossy")
+    };
+    assert_eq!(alpha, 1e-4);
     assert_eq!(
         quiet("Kd 0.5 0.5 0.5\nKs 0 0 0\nillum 2"),
         Material::Lambertian { albedo: v(0.5) }
