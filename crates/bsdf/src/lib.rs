@@ -217,19 +217,23 @@ impl Bsdf {
     }
 
     /// [`Bsdf::sample`], but for the Glossy model one lobe alone ([`Glossy::sample_lobe`]);
-    /// the flag is true when the lobe sampled is diffuse (a Lambertian model's always).
+    /// the flag is true when the lobe sampled is diffuse (a Lambertian model's always), and
+    /// the last value is the whole BSDF's density of `wi` (what MIS weighs), which only the
+    /// Glossy model has to evaluate apart.
     pub fn sample_lobe(
         &self,
         wo: Vec3,
         uc: f32,
         u: [f32; 2],
         mode: TransportMode,
-    ) -> Option<(BsdfSample, bool)> {
+    ) -> Option<(BsdfSample, bool, f32)> {
         match self {
-            Bsdf::Glossy(g) if wo.z != 0.0 => g.sample_lobe(wo, uc, u),
+            Bsdf::Glossy(g) if wo.z != 0.0 => g
+                .sample_lobe(wo, uc, u)
+                .map(|(s, diffuse)| (s, diffuse, g.pdf(wo, s.wi))),
             _ => self
                 .sample(wo, uc, u, mode)
-                .map(|s| (s, matches!(self, Bsdf::Lambertian(_)))),
+                .map(|s| (s, matches!(self, Bsdf::Lambertian(_)), s.pdf)),
         }
     }
 

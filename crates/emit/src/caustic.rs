@@ -205,12 +205,10 @@ fn trace_one(
                 return;
             };
             if !matches!(bsdf, Bsdf::Lambertian(_)) {
-                let kept = flux * s.weight();
-                let survive = (kept.max_element() / flux.max_element()).min(1.0);
-                if rng.uniform() >= survive || survive.is_nan() {
+                let Some(f) = crate::trace::glossy_roulette(flux, &s, &mut rng) else {
                     return;
-                }
-                flux = kept / survive;
+                };
+                flux = f;
             }
             ray = hit.point.spawn_ray(wi);
             continue;

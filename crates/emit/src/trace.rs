@@ -143,6 +143,16 @@ pub(crate) fn scatter(
     sides_agree(wo, wi, ng, wo_local, s.wi).then_some((wi, s))
 }
 
+/// A photon's flux after a glossy bounce: the sample's weight, then Russian roulette on the
+/// share of the flux it keeps (Jensen 2001 §5.3 for the diffuse case); `None` when the
+/// photon ends. Its number is drawn here, at glossy hits only, so scenes without them keep
+/// their streams.
+pub(crate) fn glossy_roulette(flux: Vec3, s: &bsdf::BsdfSample, rng: &mut Rng) -> Option<Vec3> {
+    let kept = flux * s.weight();
+    let survive = (kept.max_element() / flux.max_element()).min(1.0);
+    (rng.uniform() < survive).then(|| kept / survive)
+}
+
 struct Tracer<'a> {
     scene: &'a Scene,
     params: &'a EmitParams,
@@ -211,16 +221,10 @@ impl Tracer<'_> {
                 flux *= s.weight();
                 specular_bounces += 1;
             } else if !matches!(bsdf, Bsdf::Lambertian(_)) {
-                // A glossy bounce: the sample's weight, then Russian roulette on the share
-                // of the flux it keeps (Jensen 2001 §5.3 for the diffuse case). Its number
-                // is drawn here, at glossy hits only, so scenes without them keep their
-                // streams.
-                let kept = flux * s.weight();
-                let survive = (kept.max_element() / flux.max_element()).min(1.0);
-                if rng.uniform() >= survive || survive.is_nan() {
+                let Some(f) = glossy_roulette(flux, &s, &mut rng) else {
                     return;
-                }
-                flux = kept / survive;
+                };
+                flux = f;
             }
             ray = hit.point.spawn_ray(wi);
         }

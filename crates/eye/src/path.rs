@@ -183,7 +183,7 @@ impl<'a> PathTracer<'a> {
 
             // One lobe at a time, weighted by it alone, so each path has one class (a
             // Glossy surface's diffuse part is a caustic receiver, its GGX part not).
-            let Some((s, diffuse_lobe)) =
+            let Some((s, diffuse_lobe, pdf_all)) =
                 bsdf.sample_lobe(wo_l, u_lobe, u_dir, TransportMode::Radiance)
             else {
                 break;
@@ -205,7 +205,7 @@ impl<'a> PathTracer<'a> {
             from_diffuse = if s.is_specular() {
                 None
             } else {
-                Some((hit.point.p, bsdf.pdf(wo_l, s.wi)))
+                Some((hit.point.p, pdf_all))
             };
             ray = hit.point.spawn_ray(wi);
             bounces += 1;
