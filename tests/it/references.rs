@@ -166,7 +166,11 @@ type Control = (&'static str, Box<dyn Fn(&mut SceneFile)>);
 
 fn controls() -> Vec<Control> {
     let lambertian =
-        |albedo: [f32; 3], emission: [f32; 3]| MaterialDesc::Lambertian { albedo, emission };
+        |albedo: [f32; 3], emission: [f32; 3]| MaterialDesc::Lambertian {
+            albedo,
+            emission,
+            texture: None,
+        };
     vec![
         (
             "light power +2%",
@@ -726,6 +730,7 @@ fn a_glossy_receiver_matches_mitsuba() {
             MaterialDesc::Lambertian {
                 albedo: [0.5; 3],
                 emission: [0.0; 3],
+                texture: None,
             },
         );
     });

@@ -246,6 +246,16 @@ impl Bsdf {
         }
     }
 
+    /// The same model with its Lambertian lobe's albedo replaced (a texture's value at a
+    /// surface point); models without one are returned as they are.
+    pub fn with_diffuse_albedo(self, albedo: Vec3) -> Bsdf {
+        match self {
+            Bsdf::Lambertian(_) => Bsdf::Lambertian(Lambertian { albedo }),
+            Bsdf::Glossy(g) => Bsdf::Glossy(Glossy { albedo, ..g }),
+            other => other,
+        }
+    }
+
     /// True for a model with a microfacet (glossy) lobe.
     pub fn is_glossy(&self) -> bool {
         self.roughness().is_some()

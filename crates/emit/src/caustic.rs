@@ -138,7 +138,7 @@ fn trace_one(
             return;
         };
         let (uc, u) = (rng.uniform(), rng.uniform2());
-        let Some(bsdf) = scene.bsdf(hit.material) else {
+        let Some(bsdf) = scene.bsdf_at(&hit) else {
             return;
         };
         let d = ray.d.normalize();

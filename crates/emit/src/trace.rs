@@ -184,7 +184,7 @@ impl Tracer<'_> {
                 return;
             };
             let (uc, u) = (rng.uniform(), rng.uniform2());
-            let Some(bsdf) = self.scene.bsdf(hit.material) else {
+            let Some(bsdf) = self.scene.bsdf_at(&hit) else {
                 return;
             };
             let d = ray.d.normalize();

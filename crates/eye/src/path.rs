@@ -157,7 +157,7 @@ impl<'a> PathTracer<'a> {
             let u_rr = rng.uniform();
 
             // Black surfaces absorb: nothing more can be added along this path.
-            let Some(bsdf) = self.scene.bsdf(hit.material) else {
+            let Some(bsdf) = self.scene.bsdf_at(&hit) else {
                 break;
             };
             let ng = hit.point.n;

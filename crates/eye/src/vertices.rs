@@ -182,7 +182,7 @@ pub(crate) fn first_diffuse(
         let wo = -b.ray.d.normalize();
         let (u_lobe, u_dir) = (rng.uniform(), rng.uniform2());
         // Black surfaces absorb.
-        let Some(bsdf) = scene.bsdf(hit.material) else {
+        let Some(bsdf) = scene.bsdf_at(&hit) else {
             continue;
         };
         let length = b.length + hit.t * b.ray.d.length();

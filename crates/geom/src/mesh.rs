@@ -1,5 +1,5 @@
 use crate::Bounds3;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// All triangles of a scene in world space, in one indexed mesh.
 #[derive(Clone, Debug, Default)]
@@ -7,6 +7,8 @@ pub struct TriMesh {
     pub positions: Vec<Vec3>,
     /// Per-vertex shading normals: empty (flat shading) or one per position.
     pub normals: Vec<Vec3>,
+    /// Per-vertex texture coordinates (OBJ `vt`): empty or one per position.
+    pub texcoords: Vec<Vec2>,
     pub indices: Vec<[u32; 3]>,
     /// Material id of each triangle.
     pub materials: Vec<u32>,
@@ -34,6 +36,18 @@ impl TriMesh {
     pub fn face_normal(&self, tri: usize) -> Vec3 {
         let [p0, p1, p2] = self.vertices(tri);
         (p1 - p0).cross(p2 - p0)
+    }
+
+    /// Texture coordinate at barycentrics `(b1, b2)` of triangle `tri`; `None` where the mesh
+    /// has no texture coordinates.
+    pub fn texcoord(&self, tri: usize, [b1, b2]: [f32; 2]) -> Option<Vec2> {
+        let [a, b, c] = self.indices.get(tri)?.map(|i| i as usize);
+        let (ta, tb, tc) = (
+            self.texcoords.get(a)?,
+            self.texcoords.get(b)?,
+            self.texcoords.get(c)?,
+        );
+        Some((1.0 - b1 - b2) * *ta + b1 * *tb + b2 * *tc)
     }
 
     pub fn area(&self, tri: usize) -> f32 {
@@ -65,6 +79,21 @@ impl TriMesh {
             } else {
                 self.normals
                     .extend(std::iter::repeat_n(Vec3::ZERO, other.positions.len()));
+            }
+        }
+        // Texture coordinates likewise: zero where a part has none (its materials carry no
+        // texture, or the loader said so).
+        let self_uv = !self.texcoords.is_empty();
+        let other_uv = !other.texcoords.is_empty();
+        if self_uv || other_uv {
+            if !self_uv {
+                self.texcoords = vec![Vec2::ZERO; self.positions.len()];
+            }
+            if other_uv {
+                self.texcoords.extend_from_slice(&other.texcoords);
+            } else {
+                self.texcoords
+                    .extend(std::iter::repeat_n(Vec2::ZERO, other.positions.len()));
             }
         }
         self.positions.extend_from_slice(&other.positions);

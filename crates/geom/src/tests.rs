@@ -66,6 +66,7 @@ fn mesh_of(parts: &[(Vec<Vec3>, Vec<[u32; 3]>)]) -> TriMesh {
             normals: vec![],
             indices: i.clone(),
             materials: vec![mat as u32; i.len()],
+            ..TriMesh::default()
         });
     }
     m
@@ -444,6 +445,7 @@ fn shading_normals_interpolate_and_face_the_same_side() {
         positions: p,
         normals: n,
         indices: i,
+        ..TriMesh::default()
     };
     let geo = Geometry::new(m, vec![]);
     let mut rng = Rng::new(2);

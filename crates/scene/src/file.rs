@@ -269,6 +269,10 @@ pub enum MaterialDesc {
         albedo: [f32; 3],
         #[serde(default)]
         emission: [f32; 3],
+        /// An albedo texture (PNG, JPEG, TGA or EXR, relative to the scene file) that
+        /// `albedo` multiplies, as MTL's `Kd` multiplies `map_Kd`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        texture: Option<String>,
     },
     Mirror {
         #[serde(default = "one3")]
@@ -286,6 +290,9 @@ pub enum MaterialDesc {
         albedo: [f32; 3],
         specular: [f32; 3],
         alpha: f32,
+        /// An albedo texture for the Lambertian part, as `lambertian`'s.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        texture: Option<String>,
     },
     /// A rough metal (GGX, roughness `alpha`): reflectance `reflectance` times the Fresnel
     /// term of the complex index `eta + i k` where both are given, else times 1 (Mitsuba 3's

@@ -17,6 +17,7 @@ mod lights;
 mod load;
 mod material;
 mod polygon;
+mod texture;
 mod world;
 
 pub use camera::Camera;
@@ -28,6 +29,7 @@ pub use file::{
 pub use lights::{Emitted, LightPoint, LightSample, LightTable};
 pub use load::{AreaLight, Scene, fnv1a64};
 pub use material::{ALPHA_RANGE, Material};
+pub use texture::{Texture, srgb_to_linear};
 pub use world::{SPHERE_BIT, bsdf_of, sides_agree, surface_id};
 
 #[cfg(test)]

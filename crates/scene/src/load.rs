@@ -14,10 +14,10 @@
 
 use crate::file::{EmissionSource, MaterialDesc, MeshDesc, NormalMode, Scale, SceneFile};
 use crate::material::ALPHA_RANGE;
-use crate::{Camera, LightTable, Material, RenderSettings, SceneError};
+use crate::{Camera, LightTable, Material, RenderSettings, SceneError, Texture};
 use bsdf::Bsdf;
 use geom::{Geometry, Sphere, TriMesh, smooth_vertex_normals};
-use glam::{DMat3, DMat4, DVec3, Vec3};
+use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::io::BufReader;
@@ -36,6 +36,15 @@ pub struct AreaLight {
     pub power: Vec3,
 }
 
+/// A material's albedo texture: the diffuse albedo at a point is `scale` times the texture's
+/// value there (MTL: `Kd` times `map_Kd`, as the MTL spec multiplies them).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AlbedoMap {
+    /// Index into [`Scene::textures`].
+    pub texture: u32,
+    pub scale: Vec3,
+}
+
 /// A loaded scene, ready to trace.
 pub struct Scene {
     pub path: PathBuf,
@@ -52,6 +61,10 @@ pub struct Scene {
     /// BSDF per material (`None`: black, absorbs), built once for every pass
     /// ([`Scene::bsdf`]).
     pub bsdfs: Vec<Option<Bsdf>>,
+    /// Albedo texture per material (MTL `map_Kd`, scene-file `texture`), `None` for most:
+    /// [`Scene::bsdf_at`] multiplies its lookup into the diffuse lobe.
+    pub albedo_maps: Vec<Option<AlbedoMap>>,
+    pub textures: Vec<Texture>,
     pub camera: Camera,
     /// FNV-1a hash of the scene file and every file it names, in order.
     pub content_hash: u64,
@@ -213,6 +226,10 @@ struct Builder<'a> {
     names: Vec<String>,
     emission: Vec<Vec3>,
     by_name: HashMap<String, u32>,
+    albedo_maps: Vec<Option<AlbedoMap>>,
+    textures: Vec<Texture>,
+    /// Textures by the path that named them: a texture several materials share loads once.
+    texture_ids: HashMap<PathBuf, u32>,
     warnings: Vec<String>,
 }
 
@@ -232,12 +249,17 @@ impl<'a> Builder<'a> {
             names: Vec::new(),
             emission: Vec::new(),
             by_name: HashMap::new(),
+            albedo_maps: Vec::new(),
+            textures: Vec::new(),
+            texture_ids: HashMap::new(),
             warnings: Vec::new(),
         };
         // Scene-file materials first: they win over MTL materials of the same name.
         for (name, desc) in &file.materials {
             let (m, e) = match desc {
-                MaterialDesc::Lambertian { albedo, emission } => (
+                MaterialDesc::Lambertian {
+                    albedo, emission, ..
+                } => (
                     Material::Lambertian {
                         albedo: Vec3::from(*albedo),
                     },
@@ -262,6 +284,7 @@ impl<'a> Builder<'a> {
                     albedo,
                     specular,
                     alpha,
+                    ..
                 } => (
                     Material::Glossy {
                         albedo: Vec3::from(*albedo),
@@ -307,8 +330,78 @@ impl<'a> Builder<'a> {
         self.materials.push(m);
         self.names.push(name.to_string());
         self.emission.push(e);
+        self.albedo_maps.push(None);
         self.by_name.insert(name.to_string(), id);
         id
+    }
+
+    /// Reads the texture at `path` (once per path) and returns its index; `Err` is the
+    /// problem, for the caller to name the file that asked for it.
+    fn texture(&mut self, path: &Path) -> Result<u32, String> {
+        if let Some(&id) = self.texture_ids.get(path) {
+            return Ok(id);
+        }
+        let bytes = read_regular(path).map_err(|e| format!("cannot read it: {e}"))?;
+        self.hash.write(&bytes);
+        let t = Texture::decode(&bytes)?;
+        let id = self.textures.len() as u32;
+        self.textures.push(t);
+        self.texture_ids.insert(path.to_path_buf(), id);
+        Ok(id)
+    }
+
+    /// Gives material `id` the albedo texture at `path`, the material's own albedo becoming
+    /// the texture's scale. Only materials with a diffuse lobe take one; for the others the
+    /// texture is not drawn. `Ok` holds a warning, if any; `Err` the problem with the image.
+    fn attach_albedo_map(&mut self, id: u32, path: &Path) -> Result<Option<String>, String> {
+        let Some(m) = self.materials.get(id as usize).cloned() else {
+            return Err(format!("internal error: material id {id}"));
+        };
+        let texture = self.texture(path)?;
+        let mut warning = None;
+        let scale = match m {
+            Material::Lambertian { albedo } => albedo,
+            Material::Glossy {
+                albedo,
+                specular,
+                alpha,
+            } => {
+                // The untextured rule (`Kd + Ks <= 1` per channel, both scaled there where
+                // not) over the texture's brightest texel: no point reflects more than it gets.
+                let t_max = self
+                    .textures
+                    .get(texture as usize)
+                    .map_or(Vec3::ONE, Texture::max);
+                let sum = albedo * t_max + specular;
+                let f = Vec3::select(sum.cmpgt(Vec3::ONE), sum.recip(), Vec3::ONE);
+                if f != Vec3::ONE {
+                    warning = Some(format!(
+                        "`Kd` x `map_Kd`'s brightest texel + `Ks` exceeds 1 in a channel ({} {} \
+                         {}): both scaled there to sum to 1",
+                        sum.x, sum.y, sum.z
+                    ));
+                    if let Some(mat) = self.materials.get_mut(id as usize) {
+                        *mat = Material::Glossy {
+                            albedo: albedo * f,
+                            specular: specular * f,
+                            alpha,
+                        };
+                    }
+                }
+                albedo * f
+            }
+            _ => {
+                return Ok(Some(format!(
+                    "`map_Kd {}`: only diffuse and glossy (illum 0-2) materials are textured; \
+                     this one is drawn without it",
+                    path.display()
+                )));
+            }
+        };
+        if let Some(slot) = self.albedo_maps.get_mut(id as usize) {
+            *slot = Some(AlbedoMap { texture, scale });
+        }
+        Ok(warning)
     }
 
     fn err(&self, problem: impl Into<String>) -> SceneError {
@@ -328,6 +421,27 @@ impl<'a> Builder<'a> {
 
     fn build(mut self, file: SceneFile) -> Result<Scene, SceneError> {
         self.validate_materials()?;
+        for (name, desc) in &file.materials {
+            let (MaterialDesc::Lambertian {
+                texture: Some(t), ..
+            }
+            | MaterialDesc::Glossy {
+                texture: Some(t), ..
+            }) = desc
+            else {
+                continue;
+            };
+            let image = self.dir.join(t);
+            let id = self.by_name.get(name).copied().unwrap_or(u32::MAX);
+            let warned = self.attach_albedo_map(id, &image).map_err(|p| {
+                self.err(format!(
+                    "material `{name}`: texture `{t}` ({}): {p}",
+                    image.display()
+                ))
+            })?;
+            let at = |w: String| format!("{}: material `{name}`: {w}", self.scene_path.display());
+            self.warnings.extend(warned.map(at));
+        }
         for (i, m) in file.meshes.iter().enumerate() {
             self.load_mesh(i, m)?;
         }
@@ -458,6 +572,8 @@ impl<'a> Builder<'a> {
             file,
             geometry: Geometry::new(self.mesh, self.spheres),
             bsdfs: self.materials.iter().map(crate::world::bsdf_of).collect(),
+            albedo_maps: self.albedo_maps,
+            textures: self.textures,
             warnings: self.warnings,
             materials: self.materials,
             material_names: self.names,
@@ -627,7 +743,22 @@ impl<'a> Builder<'a> {
                         SceneError::new(&mtl, format!("material `{}`: {p}", m.name))
                     })?;
                     self.warnings.extend(c.warnings.into_iter().map(at));
-                    self.add_material(&m.name, c.material, c.emission)
+                    let id = self.add_material(&m.name, c.material, c.emission);
+                    if let Some(t) = &c.albedo_map {
+                        let image = mtl.parent().unwrap_or(Path::new("")).join(t);
+                        let warned = self.attach_albedo_map(id, &image).map_err(|p| {
+                            SceneError::new(
+                                &mtl,
+                                format!(
+                                    "material `{}`: `map_Kd {t}`: {}: {p}",
+                                    m.name,
+                                    image.display()
+                                ),
+                            )
+                        })?;
+                        self.warnings.extend(warned.map(at));
+                    }
+                    id
                 }
             };
             mat_ids.push(id);
@@ -765,6 +896,27 @@ impl<'a> Builder<'a> {
                 crate::polygon::triangulate(face, &part.positions, &mut triangles)
                     .map_err(|p| oerr(format!("object `{}`, face {}: {p}", model.name, f + 1)))?;
             }
+            if m.texcoords.len() == 2 * nv {
+                for (v, &[u, w]) in m.texcoords.as_chunks::<2>().0.iter().enumerate() {
+                    if !(u.is_finite() && w.is_finite()) {
+                        return Err(oerr(format!(
+                            "object `{}`: texture coordinate {} is not finite",
+                            model.name,
+                            v + 1
+                        )));
+                    }
+                    part.texcoords.push(Vec2::new(u, w));
+                }
+            } else if self.albedo_maps.get(mat as usize).is_some_and(Option::is_some) {
+                // Mitsuba 3 reads a mesh without texture coordinates at its barycentrics.
+                self.warnings.push(format!(
+                    "{}: object `{}` has no texture coordinates (`vt`) for the texture of \
+                     material `{}`: read at each triangle's barycentric coordinates",
+                    obj_path.display(),
+                    model.name,
+                    self.names.get(mat as usize).map_or("?", String::as_str)
+                ));
+            }
             part.materials = vec![mat; triangles.len()];
             part.indices = triangles;
             if desc.normals == NormalMode::Smooth {
@@ -875,6 +1027,8 @@ fn in_unit(v: Vec3) -> bool {
 struct Converted {
     material: Material,
     emission: Vec3,
+    /// `map_Kd`'s file name, relative to the MTL file.
+    albedo_map: Option<String>,
     warnings: Vec<String>,
 }
 
@@ -900,8 +1054,27 @@ const UNREAD_KEYS: [(&str, &str); 12] = [
 /// naming the key at fault.
 fn convert_mtl(m: &tobj::Material, emission: EmissionSource) -> Result<Converted, String> {
     let v = |a: Option<[f32; 3]>| a.map(Vec3::from).unwrap_or(Vec3::ZERO);
-    let kd = v(m.diffuse);
     let mut warnings = Vec::new();
+    // The MTL spec multiplies `map_Kd` by `Kd`; a texture without a `Kd` is drawn as it is.
+    let albedo_map = m.diffuse_texture.clone();
+    let kd = match (m.diffuse, &albedo_map) {
+        (None, Some(_)) => Vec3::ONE,
+        (kd, _) => v(kd),
+    };
+    if let Some(t) = &albedo_map {
+        if t.trim_start().starts_with('-') {
+            return Err(format!(
+                "`map_Kd {t}`: texture options (-s, -o, -clamp, ...) are not read; give the \
+                 image file alone"
+            ));
+        }
+        if kd == Vec3::ZERO {
+            warnings.push(format!(
+                "`map_Kd {t}` with `Kd 0 0 0`: the MTL spec multiplies the two, so the surface \
+                 is black"
+            ));
+        }
+    }
     let e = match emission {
         EmissionSource::Ke => v(m.emissive),
         EmissionSource::Ka => {
@@ -957,14 +1130,13 @@ fn convert_mtl(m: &tobj::Material, emission: EmissionSource) -> Result<Converted
         }
     }
     for (key, tex) in [
-        ("map_Kd", &m.diffuse_texture),
         ("map_Ks", &m.specular_texture),
         ("map_d", &m.dissolve_texture),
     ] {
         if let Some(t) = tex {
             return Err(format!(
-                "`{key} {t}`: texture maps are not rendered yet; remove the line to draw the \
-                 material's constant colour"
+                "`{key} {t}`: of the texture maps only `map_Kd` is rendered; remove the line \
+                 to draw the material's constant value"
             ));
         }
     }
@@ -1125,6 +1297,7 @@ fn convert_mtl(m: &tobj::Material, emission: EmissionSource) -> Result<Converted
     Ok(Converted {
         material: mat,
         emission: e,
+        albedo_map,
         warnings,
     })
 }

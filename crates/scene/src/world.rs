@@ -5,8 +5,8 @@
 
 use crate::{Material, Scene};
 use bsdf::{Bsdf, Dielectric, Glossy, Lambertian, Metal, Mirror, RoughConductor, RoughDielectric};
-use geom::Prim;
-use glam::Vec3;
+use geom::{Hit, Prim};
+use glam::{Vec2, Vec3};
 
 /// Set in a surface id for a sphere; clear for a triangle.
 pub const SPHERE_BIT: u32 = 0x8000_0000;
@@ -77,6 +77,32 @@ impl Scene {
     #[inline]
     pub fn bsdf(&self, material: u32) -> Option<Bsdf> {
         self.bsdfs[material as usize]
+    }
+
+    /// The BSDF at a surface point: [`Scene::bsdf`], its diffuse albedo read from the
+    /// material's texture where it has one. Every pass asks this of its hits, so the eye
+    /// pass, photon scattering, the estimates at receivers and splats see one albedo.
+    #[inline]
+    pub fn bsdf_at(&self, hit: &Hit) -> Option<Bsdf> {
+        let b = self.bsdfs[hit.material as usize];
+        match self.albedo_maps[hit.material as usize] {
+            None => b,
+            Some(map) => {
+                let t = &self.textures[map.texture as usize];
+                b.map(|b| b.with_diffuse_albedo(map.scale * t.eval(self.texcoord(hit))))
+            }
+        }
+    }
+
+    /// Texture coordinate of a hit: interpolated OBJ `vt` on triangles that have them, else
+    /// the hit's own parameterisation (a triangle's barycentrics `(b1, b2)`, as Mitsuba 3
+    /// reads a mesh without `vt`; a sphere's `(phi / 2pi, theta / pi)`).
+    pub fn texcoord(&self, hit: &Hit) -> Vec2 {
+        let own = Vec2::from(hit.uv);
+        match hit.prim {
+            Prim::Triangle(t) => self.geometry.mesh().texcoord(t as usize, hit.uv).unwrap_or(own),
+            Prim::Sphere(_) => own,
+        }
     }
 
     /// Diffuse: a BSDF with a diffuse lobe (Lambertian, or the Glossy model's Lambertian

@@ -1,0 +1,116 @@
+//! Colour textures (MTL `map_Kd`): decoded once at load into linear RGB, looked up bilinearly
+//! with repeat wrapping, the defaults of Mitsuba 3's `bitmap` texture, so its images are
+//! references for textured scenes.
+
+use glam::{Vec2, Vec3};
+
+/// Largest texture photonflow loads, in texels: 2^26 (8192 x 8192) is 768 MiB of f32 RGB,
+/// beyond any albedo map a scene needs; a larger header is taken for a damaged file.
+const MAX_TEXELS: u64 = 1 << 26;
+
+/// A linear-RGB image, row 0 at the top (as files store them).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    pub width: usize,
+    pub height: usize,
+    pub texels: Vec<Vec3>,
+}
+
+/// The sRGB transfer function's inverse (IEC 61966-2-1), per channel.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+impl Texture {
+    /// Decodes a PNG, JPEG, TGA or EXR file's bytes. Integer images are sRGB-encoded (what image files hold
+    /// unless they say otherwise, and what Mitsuba 3 assumes of them) and decoded to linear;
+    /// float images (EXR) are linear already. Grey images are read as equal channels; alpha
+    /// is not read (`map_Kd` is a colour, and MTL's `map_d` is the transparency). `Err` is one
+    /// line saying what is wrong, without the path (the caller names the file).
+    pub fn decode(bytes: &[u8]) -> Result<Texture, String> {
+        let reader = || {
+            image::ImageReader::new(std::io::Cursor::new(bytes))
+                .with_guessed_format()
+                .map_err(|e| format!("cannot read it: {e}"))
+        };
+        let (w, h) = reader()?
+            .into_dimensions()
+            .map_err(|e| format!("not a PNG, JPEG, TGA or EXR image photonflow can read: {e}"))?;
+        if w == 0 || h == 0 {
+            return Err(format!("the image is empty ({w}x{h})"));
+        }
+        if w as u64 * h as u64 > MAX_TEXELS {
+            return Err(format!(
+                "a {w}x{h} image is larger than the {MAX_TEXELS} texels photonflow loads"
+            ));
+        }
+        let img = reader()?
+            .decode()
+            .map_err(|e| format!("cannot decode it: {e}"))?;
+        let linear = matches!(
+            img.color(),
+            image::ColorType::Rgb32F | image::ColorType::Rgba32F
+        );
+        let rgb = img.into_rgb32f();
+        let texels: Vec<Vec3> = rgb
+            .pixels()
+            .map(|p| {
+                let c = Vec3::from(p.0);
+                if linear {
+                    c
+                } else {
+                    Vec3::new(
+                        srgb_to_linear(c.x),
+                        srgb_to_linear(c.y),
+                        srgb_to_linear(c.z),
+                    )
+                }
+            })
+            .collect();
+        if let Some(bad) = texels.iter().find(|c| !(c.is_finite() && c.min_element() >= 0.0)) {
+            return Err(format!(
+                "texel {:?} is negative or not finite: an albedo lies in [0, 1]",
+                bad.to_array()
+            ));
+        }
+        Ok(Texture {
+            width: rgb.width() as usize,
+            height: rgb.height() as usize,
+            texels,
+        })
+    }
+
+    /// The largest value of each channel over the texture.
+    pub fn max(&self) -> Vec3 {
+        self.texels.iter().fold(Vec3::ZERO, |m, &c| m.max(c))
+    }
+
+    /// Bilinear lookup at texture coordinate `uv`, repeated outside [0, 1)^2. `v` runs up the
+    /// image (OBJ's convention: `v = 0` is the bottom row); texel centres lie at half-integer
+    /// coordinates (Mitsuba 3's `bitmap`: `filter_type = bilinear`, `wrap_mode = repeat`).
+    pub fn eval(&self, uv: Vec2) -> Vec3 {
+        let x = uv.x * self.width as f32 - 0.5;
+        let y = (1.0 - uv.y) * self.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let wrap = |i: f32, n: usize| -> usize {
+            // rem_euclid of a finite float lands in [0, n); a NaN coordinate reads texel 0.
+            let r = (i as i64).rem_euclid(n as i64) as usize;
+            r.min(n - 1)
+        };
+        let (xa, xb) = (wrap(x0, self.width), wrap(x0 + 1.0, self.width));
+        let (ya, yb) = (wrap(y0, self.height), wrap(y0 + 1.0, self.height));
+        let at = |x: usize, y: usize| self.texels[y * self.width + x];
+        // `a + (b - a) t`: exact where neighbours are equal, so a constant texture reads its
+        // value to the bit.
+        let lerp = |a: Vec3, b: Vec3, t: f32| a + (b - a) * t;
+        let top = lerp(at(xa, ya), at(xb, ya), fx);
+        let bottom = lerp(at(xa, yb), at(xb, yb), fx);
+        let c = lerp(top, bottom, fy);
+        if c.is_finite() { c } else { at(0, 0) }
+    }
+}
