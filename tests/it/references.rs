@@ -165,12 +165,11 @@ fn path_image(scene: &Scene, spp: u32) -> Image {
 type Control = (&'static str, Box<dyn Fn(&mut SceneFile)>);
 
 fn controls() -> Vec<Control> {
-    let lambertian =
-        |albedo: [f32; 3], emission: [f32; 3]| MaterialDesc::Lambertian {
-            albedo,
-            emission,
-            texture: None,
-        };
+    let lambertian = |albedo: [f32; 3], emission: [f32; 3]| MaterialDesc::Lambertian {
+        albedo,
+        emission,
+        texture: None,
+    };
     vec![
         (
             "light power +2%",

@@ -11,7 +11,7 @@
 # VARIANT     Mitsuba variant, default llvm_ad_rgb (needs libLLVM >= 16); scalar_rgb is slower
 #             and draws different random numbers, so its images differ within noise
 # NAME        cornell-spheres-analytic, cornell-spheres-closeup, cornell-glossy, cornell-rough,
-#             furnace, plane-light, corner (default: all)
+#             cornell-textured, furnace, plane-light, corner (default: all)
 # `stats` prints the noise figures of the halves present (the tables of README.md).
 #
 # The scenes are read from scenes/*.toml of this repository (camera, and checks that the
@@ -156,7 +156,7 @@ EOF
 P=$PEERS/worksheet
 S=$REPO/scenes
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough furnace plane-light corner)
+[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough cornell-textured furnace plane-light corner)
 for n in "${names[@]}"; do
   case $n in
     cornell-spheres-analytic)
@@ -169,6 +169,10 @@ for n in "${names[@]}"; do
     cornell-rough)
       render $n obj-spheres "$S/cornell-glossy/rough-spheres.toml" 128 128 8192 1024 \
         "$S/cornell-glossy/box.obj" --spheres "$TMP/$n-128x128-spheres.json" --glossy ;;
+    cornell-textured)
+      # The floor's map_Kd: mitsuba_render_rough.py's bitmap texture over the OBJ's vt.
+      render $n obj-spheres "$S/cornell-textured/textured-floor.toml" 128 128 8192 1024 \
+        "$S/cornell-textured/box.obj" --spheres "$TMP/$n-128x128-spheres.json" ;;
     cornell-spheres-closeup)
       render $n worksheet "$S/cornell-spheres/closeup.toml" 128 128 8192 1024 \
         "$P/cornell_worksheet_box.obj" --spheres "$P/cornell_worksheet_spheres.json" ;;

@@ -343,7 +343,7 @@ impl<'a> Builder<'a> {
         }
         let bytes = read_regular(path).map_err(|e| format!("cannot read it: {e}"))?;
         self.hash.write(&bytes);
-        let t = Texture::decode(&bytes)?;
+        let t = Texture::decode(&bytes, path)?;
         let id = self.textures.len() as u32;
         self.textures.push(t);
         self.texture_ids.insert(path.to_path_buf(), id);
@@ -907,7 +907,11 @@ impl<'a> Builder<'a> {
                     }
                     part.texcoords.push(Vec2::new(u, w));
                 }
-            } else if self.albedo_maps.get(mat as usize).is_some_and(Option::is_some) {
+            } else if self
+                .albedo_maps
+                .get(mat as usize)
+                .is_some_and(Option::is_some)
+            {
                 // Mitsuba 3 reads a mesh without texture coordinates at its barycentrics.
                 self.warnings.push(format!(
                     "{}: object `{}` has no texture coordinates (`vt`) for the texture of \

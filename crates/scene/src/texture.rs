@@ -3,6 +3,7 @@
 //! references for textured scenes.
 
 use glam::{Vec2, Vec3};
+use std::path::Path;
 
 /// Largest texture photonflow loads, in texels: 2^26 (8192 x 8192) is 768 MiB of f32 RGB,
 /// beyond any albedo map a scene needs; a larger header is taken for a damaged file.
@@ -31,11 +32,18 @@ impl Texture {
     /// float images (EXR) are linear already. Grey images are read as equal channels; alpha
     /// is not read (`map_Kd` is a colour, and MTL's `map_d` is the transparency). `Err` is one
     /// line saying what is wrong, without the path (the caller names the file).
-    pub fn decode(bytes: &[u8]) -> Result<Texture, String> {
+    /// `name` is the file's name: TGA files carry no signature, so their extension tells.
+    pub fn decode(bytes: &[u8], name: &Path) -> Result<Texture, String> {
         let reader = || {
-            image::ImageReader::new(std::io::Cursor::new(bytes))
+            let mut r = image::ImageReader::new(std::io::Cursor::new(bytes))
                 .with_guessed_format()
-                .map_err(|e| format!("cannot read it: {e}"))
+                .map_err(|e| format!("cannot read it: {e}"))?;
+            if r.format().is_none() {
+                if let Ok(f) = image::ImageFormat::from_path(name) {
+                    r.set_format(f);
+                }
+            }
+            Ok::<_, String>(r)
         };
         let (w, h) = reader()?
             .into_dimensions()
@@ -71,7 +79,10 @@ impl Texture {
                 }
             })
             .collect();
-        if let Some(bad) = texels.iter().find(|c| !(c.is_finite() && c.min_element() >= 0.0)) {
+        if let Some(bad) = texels
+            .iter()
+            .find(|c| !(c.is_finite() && c.min_element() >= 0.0))
+        {
             return Err(format!(
                 "texel {:?} is negative or not finite: an albedo lies in [0, 1]",
                 bad.to_array()

@@ -100,7 +100,11 @@ impl Scene {
     pub fn texcoord(&self, hit: &Hit) -> Vec2 {
         let own = Vec2::from(hit.uv);
         match hit.prim {
-            Prim::Triangle(t) => self.geometry.mesh().texcoord(t as usize, hit.uv).unwrap_or(own),
+            Prim::Triangle(t) => self
+                .geometry
+                .mesh()
+                .texcoord(t as usize, hit.uv)
+                .unwrap_or(own),
             Prim::Sphere(_) => own,
         }
     }
