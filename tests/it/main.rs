@@ -32,6 +32,8 @@
 //!   shards merged give the one-machine run's photon files and images byte for byte.
 //! - `sppm`: progressive photon mapping converging to closed forms (square light, furnace) at
 //!   the rate its radius schedule predicts; snapshots, time budget, thread-count invariance.
+//! - `textures`: a constant texture draws its colour to the bit in every method (the albedo is
+//!   read from the texture wherever it is used).
 //! - `kit`: the helpers the modules share (scenes at a test's resolution and seed, methods run
 //!   as the binary runs them, layers, pixels and regions of images, means with standard
 //!   errors, scratch directories, the command line in process).
@@ -52,3 +54,4 @@ mod references;
 mod shards;
 mod splat;
 mod sppm;
+mod textures;
