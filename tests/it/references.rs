@@ -635,8 +635,14 @@ fn the_glass_sphere_close_up_matches_mitsuba() {
 fn the_close_up_catches_a_glass_of_index_1_45() {
     let regs = closeup_regions(&closeup(1, |_| {}));
     let s = closeup(2, |f| {
-        f.materials
-            .insert("glass".into(), MaterialDesc::Dielectric { ior: 1.45 });
+        f.materials.insert(
+            "glass".into(),
+            MaterialDesc::Dielectric {
+                ior: 1.45,
+                transmittance: [1.0; 3],
+                absorption: [0.0; 3],
+            },
+        );
     });
     for (method, count, table) in [
         (Method::Path, 256, &CLOSEUP_PATH_256),
@@ -793,8 +799,14 @@ fn rough_spheres_match_mitsuba() {
                 reflectance: [0.96, 0.98, 0.96],
             },
         );
-        f.materials
-            .insert("glass".into(), MaterialDesc::Dielectric { ior: 1.5 });
+        f.materials.insert(
+            "glass".into(),
+            MaterialDesc::Dielectric {
+                ior: 1.5,
+                transmittance: [1.0; 3],
+                absorption: [0.0; 3],
+            },
+        );
     });
     eprintln!("path, 256, smooth spheres:");
     let bad = misfits(

@@ -52,6 +52,9 @@ pub struct Scene {
     /// BSDF per material (`None`: black, absorbs), built once for every pass
     /// ([`Scene::bsdf`]).
     pub bsdfs: Vec<Option<Bsdf>>,
+    /// Beer-Lambert absorption coefficient inside each material (zero but for absorbing
+    /// glass), built once for every pass ([`Scene::transmittance_to`]).
+    pub absorption: Vec<Vec3>,
     pub camera: Camera,
     /// FNV-1a hash of the scene file and every file it names, in order.
     pub content_hash: u64,
@@ -255,9 +258,18 @@ impl<'a> Builder<'a> {
                     },
                     Vec3::ZERO,
                 ),
-                MaterialDesc::Dielectric { ior } => {
-                    (Material::Dielectric { ior: *ior }, Vec3::ZERO)
-                }
+                MaterialDesc::Dielectric {
+                    ior,
+                    transmittance,
+                    absorption,
+                } => (
+                    Material::Dielectric {
+                        ior: *ior,
+                        transmittance: Vec3::from(*transmittance),
+                        absorption: Vec3::from(*absorption),
+                    },
+                    Vec3::ZERO,
+                ),
                 MaterialDesc::Glossy {
                     albedo,
                     specular,
@@ -289,10 +301,17 @@ impl<'a> Builder<'a> {
                     },
                     Vec3::ZERO,
                 ),
-                MaterialDesc::RoughDielectric { ior, alpha } => (
+                MaterialDesc::RoughDielectric {
+                    ior,
+                    alpha,
+                    transmittance,
+                    absorption,
+                } => (
                     Material::RoughDielectric {
                         ior: *ior,
                         alpha: *alpha,
+                        transmittance: Vec3::from(*transmittance),
+                        absorption: Vec3::from(*absorption),
                     },
                     Vec3::ZERO,
                 ),
@@ -458,6 +477,7 @@ impl<'a> Builder<'a> {
             file,
             geometry: Geometry::new(self.mesh, self.spheres),
             bsdfs: self.materials.iter().map(crate::world::bsdf_of).collect(),
+            absorption: self.materials.iter().map(Material::absorption).collect(),
             warnings: self.warnings,
             materials: self.materials,
             material_names: self.names,
@@ -479,7 +499,17 @@ impl<'a> Builder<'a> {
                 Material::Mirror { reflectance } | Material::Metal { reflectance } => {
                     in_unit(*reflectance)
                 }
-                Material::Dielectric { ior } => ior.is_finite() && *ior > 0.0 && *ior < 10.0,
+                Material::Dielectric {
+                    ior,
+                    transmittance,
+                    absorption,
+                } => {
+                    ior.is_finite()
+                        && *ior > 0.0
+                        && *ior < 10.0
+                        && in_unit(*transmittance)
+                        && non_negative(*absorption)
+                }
                 Material::Glossy {
                     albedo,
                     specular,
@@ -505,15 +535,26 @@ impl<'a> Builder<'a> {
                                 && k.min_element() >= 0.0
                         })
                 }
-                Material::RoughDielectric { ior, alpha } => {
-                    ior.is_finite() && *ior > 0.0 && *ior < 10.0 && ALPHA_RANGE.contains(alpha)
+                Material::RoughDielectric {
+                    ior,
+                    alpha,
+                    transmittance,
+                    absorption,
+                } => {
+                    ior.is_finite()
+                        && *ior > 0.0
+                        && *ior < 10.0
+                        && ALPHA_RANGE.contains(alpha)
+                        && in_unit(*transmittance)
+                        && non_negative(*absorption)
                 }
             };
             if !ok {
                 return Err(self.err(format!(
-                    "material `{name}`: albedo/reflectance (and albedo + specular) must lie in \
-                     [0, 1], ior in (0, 10), alpha in [1e-4, 1], eta > 0 and k >= 0 given \
-                     together (got {m:?})"
+                    "material `{name}`: albedo/reflectance/transmittance (and albedo + \
+                     specular) must lie in [0, 1], ior in (0, 10), alpha in [1e-4, 1], \
+                     absorption be finite and >= 0, eta > 0 and k >= 0 given together (got \
+                     {m:?})"
                 )));
             }
         }
@@ -870,6 +911,10 @@ fn in_unit(v: Vec3) -> bool {
     v.is_finite() && v.min_element() >= 0.0 && v.max_element() <= 1.0
 }
 
+fn non_negative(v: Vec3) -> bool {
+    v.is_finite() && v.min_element() >= 0.0
+}
+
 /// An MTL material turned into one of photonflow's: the material, its emission, and a line
 /// for each thing it approximates (printed as `warning:` lines).
 struct Converted {
@@ -993,13 +1038,13 @@ fn convert_mtl(m: &tobj::Material, emission: EmissionSource) -> Result<Converted
              glass (illum 4, 6, 7 or 9 with `Ni`)"
         ));
     }
-    if tf.is_some_and(|t| t != Vec3::ONE) {
-        if glass_illum || course_glass {
-            return Err(format!(
-                "`Tf {}`: coloured glass is not rendered yet",
-                tf_text
-            ));
-        }
+    let glassy = glass_illum || course_glass;
+    if glassy && tf.is_some_and(|t| !in_unit(t)) {
+        return Err(format!(
+            "`Tf {tf_text}`: the transmission filter of glass must lie in [0, 1] in each channel"
+        ));
+    }
+    if !glassy && tf.is_some_and(|t| t != Vec3::ONE) {
         warnings.push(format!(
             "`Tf {}`: a transmission filter is read only for glass; illum {} is opaque",
             tf_text,
@@ -1047,7 +1092,13 @@ fn convert_mtl(m: &tobj::Material, emission: EmissionSource) -> Result<Converted
                 ks.x, ks.y, ks.z
             ));
         }
-        Material::Dielectric { ior }
+        // `Tf` scales refracted light at every crossing: Mitsuba 3's
+        // `specular_transmittance`, which the peers' mapping gives it too.
+        Material::Dielectric {
+            ior,
+            transmittance: tf.unwrap_or(Vec3::ONE),
+            absorption: Vec3::ZERO,
+        }
     };
     let mat = match illum {
         _ if course_glass => glass(&mut warnings, ""),
