@@ -703,11 +703,13 @@ fn slab_closed_form(n: f64, d: f64, tau: [f32; 3], sigma: [f32; 3]) -> DVec3 {
 /// with Fresnel splits and without) against [`slab_closed_form`]. The only randomness is the
 /// Fresnel choice and Russian roulette, so both are estimates of the closed form.
 ///
-/// Measured over seeds 1-8 (40 000 paths each), path tracer, red channel (T = 0.7140):
-/// mean of the per-seed means 0.71395, sd between seeds 0.00093; the standard error each run
-/// computes, 0.0010, matches that sd, so 4 standard errors is the tolerance. Without the
-/// Beer-Lambert factor the estimate is 0.7888 (a 75-se miss), without the transmittance
-/// 0.8813.
+/// Measured over seeds 1-8 (`SLAB_SEEDS=8`; 40 000 paths each), red channel (T = 0.75358):
+/// path tracer mean of the per-seed means 0.75364, sd between seeds 0.00101; eye walk
+/// without splits 0.75362, sd 0.00153; with two splits every seed within 6e-5. The standard
+/// error each run computes (0.0011; 3e-5 with splits) is the sd's size, so 4 standard errors
+/// is the tolerance. Without the Beer-Lambert factor the path tracer gives 0.83278 (66 se
+/// off) and the split walk 0.83307; without the transmittance the path tracer gives
+/// 0.83467.
 #[test]
 fn radiance_through_an_absorbing_coloured_slab_matches_the_closed_form() {
     let tau = [0.95, 0.7, 0.4];
