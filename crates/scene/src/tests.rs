@@ -140,6 +140,7 @@ fn every_scene_in_the_tree_loads() {
     for rel in [
         "cornell-spheres/tessellated.toml",
         "cornell-spheres/analytic.toml",
+        "cornell-spheres/coloured-glass.toml",
         "furnace/furnace.toml",
         "plane-light/plane-light.toml",
         "corner/corner.toml",
