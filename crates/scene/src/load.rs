@@ -494,6 +494,32 @@ impl<'a> Builder<'a> {
 
     fn validate_materials(&self) -> Result<(), SceneError> {
         for (name, m) in self.names.iter().zip(&self.materials) {
+            // Glass's own keys first, each named alone.
+            if let Material::Dielectric {
+                transmittance,
+                absorption,
+                ..
+            }
+            | Material::RoughDielectric {
+                transmittance,
+                absorption,
+                ..
+            } = m
+            {
+                if !in_unit(*transmittance) {
+                    return Err(self.err(format!(
+                        "material `{name}`: transmittance {:?} must lie in [0, 1] in each channel",
+                        transmittance.to_array()
+                    )));
+                }
+                if !non_negative(*absorption) {
+                    return Err(self.err(format!(
+                        "material `{name}`: absorption {:?} must be finite and >= 0 in each \
+                         channel (per scene unit)",
+                        absorption.to_array()
+                    )));
+                }
+            }
             let ok = match m {
                 Material::Lambertian { albedo } => in_unit(*albedo),
                 Material::Mirror { reflectance } | Material::Metal { reflectance } => {
