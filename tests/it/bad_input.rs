@@ -312,6 +312,94 @@ fn cases() -> Vec<Case> {
             words: &["16x16", "8x8"],
             check: None,
         },
+        // Coloured and absorbing glass: the scene file's keys and MTL `Tf`.
+        Case {
+            name: "a negative absorption on glass",
+            files: files(
+                scene(
+                    "[material.glass]\ntype = \"dielectric\"\nior = 1.5\nabsorption = [0.1, -1, 0]\n",
+                ),
+                OBJ,
+                MTL,
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &[
+                "s.toml",
+                "material `glass`",
+                "absorption",
+                "finite and >= 0",
+            ],
+            check: None,
+        },
+        Case {
+            name: "a NaN absorption on rough glass",
+            files: files(
+                scene(
+                    "[material.frost]\ntype = \"rough_dielectric\"\nior = 1.5\nalpha = 0.2\nabsorption = [nan, 0, 0]\n",
+                ),
+                OBJ,
+                MTL,
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &["s.toml", "material `frost`", "absorption"],
+            check: None,
+        },
+        Case {
+            name: "a glass transmittance above 1",
+            files: files(
+                scene(
+                    "[material.glass]\ntype = \"dielectric\"\nior = 1.5\ntransmittance = [1.2, 0.5, 0.5]\n",
+                ),
+                OBJ,
+                MTL,
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &["s.toml", "material `glass`", "transmittance", "[0, 1]"],
+            check: None,
+        },
+        Case {
+            name: "MTL Tf out of range on glass",
+            files: files(
+                scene(""),
+                OBJ,
+                &MTL.replace(
+                    "Kd 0.5 0.5 0.5",
+                    "Kd 0.5 0.5 0.5\nnewmtl glass\nillum 7\nNi 1.5\nTf 1.5 0.5 0.5",
+                ),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &["m.mtl", "material `glass`", "`Tf 1.5 0.5 0.5`", "[0, 1]"],
+            check: None,
+        },
+        Case {
+            name: "MTL Tf on glass is coloured glass",
+            files: files(
+                scene(""),
+                OBJ,
+                &MTL.replace(
+                    "Kd 0.5 0.5 0.5",
+                    "Kd 0.5 0.5 0.5\nnewmtl glass\nillum 7\nNi 1.5\nTf 0.9 0.5 0.2",
+                ),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 0,
+            words: &[],
+            check: None,
+        },
         // Every command's flags.
         Case {
             name: "info on a missing scene",

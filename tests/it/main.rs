@@ -9,6 +9,8 @@
 //!   the light under the ceiling is reachable, camera rays behave).
 //! - `evidence`: bias^2 and variance apart from independent runs: zero bias for the path
 //!   tracer, a fixed-k estimate's bias growing with k at the caustic.
+//! - `glass`: coloured glass colours the light through it as `τ²` in the path tracer and
+//!   each photon method alike (a slab between a white light and a grey floor).
 //! - `hard_cases`: one table of numerically hard scenes (camera inside the glass sphere, the
 //!   light just under the ceiling, grazing rays, total internal reflection, caustic focus,
 //!   coincident photons, k above the photon count, the scene scaled by 1e-3 and 1e4,
@@ -46,6 +48,7 @@ mod bad_input;
 mod cornell;
 mod evidence;
 mod fuzz;
+mod glass;
 mod hard_cases;
 mod kit;
 mod photon_maps;

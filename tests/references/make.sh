@@ -11,7 +11,8 @@
 # VARIANT     Mitsuba variant, default llvm_ad_rgb (needs libLLVM >= 16); scalar_rgb is slower
 #             and draws different random numbers, so its images differ within noise
 # NAME        cornell-spheres-analytic, cornell-spheres-closeup, cornell-glossy, cornell-rough,
-#             cornell-textured, furnace, plane-light, corner (default: all)
+#             cornell-textured, cornell-coloured-glass, furnace, plane-light, corner (default:
+#             all)
 # `stats` prints the noise figures of the halves present (the tables of README.md).
 #
 # The scenes are read from scenes/*.toml of this repository (camera, and checks that the
@@ -91,7 +92,23 @@ else:  # worksheet: CornellBox.obj scaled 0.025, turned 180 degrees about y, two
         need(abs(sp["radius"] - r["radius"]) < 1e-6
              and max(abs(a - b) for a, b in zip(sp["center"], r["center"])) < 1e-5, "sphere " + sp["material"])
     need(mats.get("silver") == {"type": "metal", "reflectance": [0.96, 0.98, 0.96]}, "silver: constant-Ks metal")
-    need(mats.get("glass") == {"type": "dielectric", "ior": 1.5}, "glass: dielectric, ior 1.5")
+    glass = dict(mats.get("glass", {}))
+    tf = glass.pop("transmittance", None)
+    need(glass == {"type": "dielectric", "ior": 1.5}, "glass: dielectric, ior 1.5, no absorption")
+    if tf is not None:
+        # Coloured glass: the peers' spheres and MTL with the glass's `Tf` set (their mapping
+        # gives it to Mitsuba's specular_transmittance only when every channel is below 1).
+        need(max(tf) < 1.0 and min(tf) >= 0.0, "glass: transmittance below 1 in every channel")
+        with open(f"{peers}/worksheet/cornell_worksheet.mtl") as f:
+            mtl = f.read()
+        need(mtl.count("Tf 1 1 1") == 1, "the peers' MTL has one clear glass")
+        with open(out[:-5] + "-spheres.mtl", "w") as f:
+            f.write(mtl.replace("Tf 1 1 1", f"Tf {tf[0]} {tf[1]} {tf[2]}"))
+        with open(f"{peers}/worksheet/cornell_worksheet_spheres.json") as f:
+            doc = json.load(f)
+        doc["mtllib"] = os.path.basename(out)[:-5] + "-spheres.mtl"
+        with open(out[:-5] + "-spheres.json", "w") as f:
+            json.dump(doc, f)
 c = s["camera"]
 cam = {"type": "perspective", "position": c["eye"], "look_at": c["look_at"],
        "up": c.get("up", [0.0, 1.0, 0.0]), "vfov_deg": c["vfov"], "width": int(w), "height": int(h),
@@ -156,7 +173,7 @@ EOF
 P=$PEERS/worksheet
 S=$REPO/scenes
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough cornell-textured furnace plane-light corner)
+[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough cornell-textured cornell-coloured-glass furnace plane-light corner)
 for n in "${names[@]}"; do
   case $n in
     cornell-spheres-analytic)
@@ -173,6 +190,10 @@ for n in "${names[@]}"; do
       # The floor's map_Kd: mitsuba_render_rough.py's bitmap texture over the OBJ's vt.
       render $n obj-spheres "$S/cornell-textured/textured-floor.toml" 128 128 8192 1024 \
         "$S/cornell-textured/box.obj" --spheres "$TMP/$n-128x128-spheres.json" ;;
+    cornell-coloured-glass)
+      # The worksheet box, its glass sphere coloured by `Tf` (the peers' MTL, edited).
+      render $n worksheet "$S/cornell-spheres/coloured-glass.toml" 128 128 8192 1024 \
+        "$P/cornell_worksheet_box.obj" --spheres "$TMP/$n-128x128-spheres.json" ;;
     cornell-spheres-closeup)
       render $n worksheet "$S/cornell-spheres/closeup.toml" 128 128 8192 1024 \
         "$P/cornell_worksheet_box.obj" --spheres "$P/cornell_worksheet_spheres.json" ;;

@@ -8,11 +8,14 @@ use glam::Vec3;
 
 /// A rough boundary with relative index `eta` = n_inside / n_outside, the inside being the side
 /// opposite the shading normal, as for [`crate::Dielectric`]. `alpha` is clamped to
-/// [`crate::microfacet::MIN_ALPHA`].
+/// [`crate::microfacet::MIN_ALPHA`]. `transmittance` scales the transmitted lobe at every
+/// crossing, as [`crate::Dielectric`]'s does (Mitsuba 3's `roughdielectric`
+/// `specular_transmittance`); it changes neither the sampling nor the pdf.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RoughDielectric {
     pub eta: f32,
     pub alpha: f32,
+    pub transmittance: Vec3,
 }
 
 /// The microfacet normal relating `wo` and `wi`, facing +z, and the relative index `η'` crossed
@@ -24,6 +27,25 @@ struct Geometry {
 }
 
 impl RoughDielectric {
+    /// Clear rough glass of relative index `eta` and roughness `alpha`.
+    pub const fn clear(eta: f32, alpha: f32) -> RoughDielectric {
+        RoughDielectric {
+            eta,
+            alpha,
+            transmittance: Vec3::ONE,
+        }
+    }
+
+    /// The lobe's colour: 1 for reflection, the transmittance for refraction.
+    #[inline]
+    fn tint(&self, g: &Geometry) -> Vec3 {
+        if g.reflect {
+            Vec3::ONE
+        } else {
+            self.transmittance
+        }
+    }
+
     #[inline]
     pub(crate) fn distribution(&self) -> TrowbridgeReitz {
         TrowbridgeReitz::new(self.alpha)
@@ -91,7 +113,7 @@ impl RoughDielectric {
 
     pub fn f(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Vec3 {
         match self.geometry(wo, wi) {
-            Some(g) => Vec3::splat(self.f_at(wo, wi, &g, mode)),
+            Some(g) => self.tint(&g) * self.f_at(wo, wi, &g, mode),
             None => Vec3::ZERO,
         }
     }
@@ -137,7 +159,7 @@ impl RoughDielectric {
             return None;
         }
         Some(BsdfSample {
-            f: Vec3::splat(f),
+            f: self.tint(&g) * f,
             wi,
             pdf,
             flags,

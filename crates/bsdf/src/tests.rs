@@ -34,7 +34,7 @@ fn wos() -> Vec<Vec3> {
 }
 
 fn glass() -> Bsdf {
-    Dielectric { eta: 1.5 }.into()
+    Dielectric::clear(1.5).into()
 }
 
 fn all_models() -> Vec<(&'static str, Bsdf)> {
@@ -541,4 +541,71 @@ fn chi2_catches_a_forgotten_hemisphere_flip() {
     )
     .unwrap_err();
     assert!(err.contains("seed 500"), "{err}");
+}
+
+// --- Coloured glass ---------------------------------------------------------------------
+
+#[test]
+fn dielectric_transmittance_scales_the_transmitted_lobe_only() {
+    // Mitsuba 3's `specular_transmittance`: the refracted sample's value times τ, the
+    // reflected one's and both lobe probabilities unchanged, from either side, in both modes.
+    let tau = Vec3::new(0.9, 0.5, 0.1);
+    let clear = Dielectric::clear(1.5);
+    let tinted = Dielectric {
+        eta: 1.5,
+        transmittance: tau,
+    };
+    for wo in wos() {
+        for mode in [RAD, IMP] {
+            for uc in [0.0, 0.999_999] {
+                let (a, b) = (clear.sample(wo, uc, mode), tinted.sample(wo, uc, mode));
+                let (Some(a), Some(b)) = (a, b) else {
+                    assert_eq!(a, b, "wo {wo}, uc {uc}");
+                    continue;
+                };
+                assert_eq!((a.wi, a.pdf, a.flags, a.eta), (b.wi, b.pdf, b.flags, b.eta));
+                let want = if a.is_transmission() { a.f * tau } else { a.f };
+                assert_eq!(b.f, want, "wo {wo}, uc {uc}, {mode:?}");
+                if a.is_transmission() {
+                    // The throughput factor of a refraction is exactly τ (importance) or
+                    // τ / η'² (radiance): the Fresnel weight cancels against the pdf.
+                    let w = b.weight() * if mode == RAD { b.eta * b.eta } else { 1.0 };
+                    assert!((w - tau).abs().max_element() < 1e-6, "wo {wo}: {w}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn rough_dielectric_transmittance_scales_the_transmitted_lobe_only() {
+    let tau = Vec3::new(0.9, 0.5, 0.1);
+    let clear = RoughDielectric::clear(1.5, 0.3);
+    let tinted = RoughDielectric {
+        transmittance: tau,
+        ..clear
+    };
+    let mut rng = Rng::new(77);
+    let (mut seen_r, mut seen_t) = (0, 0);
+    for wo in wos() {
+        for _ in 0..64 {
+            let (uc, u) = (rng.uniform(), rng.uniform2());
+            let (a, b) = (clear.sample(wo, uc, u, RAD), tinted.sample(wo, uc, u, RAD));
+            let (Some(a), Some(b)) = (a, b) else {
+                assert_eq!(a, b);
+                continue;
+            };
+            assert_eq!((a.wi, a.pdf, a.flags), (b.wi, b.pdf, b.flags));
+            let want = if a.is_transmission() { a.f * tau } else { a.f };
+            assert_eq!(b.f, want, "wo {wo}");
+            assert_eq!(tinted.f(wo, a.wi, RAD), want);
+            assert_eq!(tinted.pdf(wo, a.wi), clear.pdf(wo, a.wi));
+            seen_r += a.is_reflection() as u32;
+            seen_t += a.is_transmission() as u32;
+        }
+    }
+    assert!(
+        seen_r > 50 && seen_t > 50,
+        "{seen_r} reflections, {seen_t} refractions"
+    );
 }

@@ -137,6 +137,12 @@ fn trace_one(
         let Some(hit) = scene.geometry.intersect(&ray) else {
             return;
         };
+        // Beer-Lambert along the segment, as in `trace_range`, so both tracers carry the same
+        // flux.
+        flux *= scene.transmittance_to(&hit, &ray);
+        if !flux.cmpgt(Vec3::ZERO).any() {
+            return;
+        }
         let (uc, u) = (rng.uniform(), rng.uniform2());
         let Some(bsdf) = scene.bsdf_at(&hit) else {
             return;

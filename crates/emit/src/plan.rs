@@ -111,6 +111,27 @@ impl Plan {
                 glossy.join(", ")
             ));
         }
+        let tinted = names(&|_, m| match *m {
+            Material::Dielectric {
+                transmittance,
+                absorption,
+                ..
+            }
+            | Material::RoughDielectric {
+                transmittance,
+                absorption,
+                ..
+            } => transmittance != glam::Vec3::ONE || absorption != glam::Vec3::ZERO,
+            _ => false,
+        });
+        if !tinted.is_empty() {
+            reasons.push(format!(
+                "coloured or absorbing glass ({}): light crossing it is scaled by its \
+                 transmittance at each crossing and by exp(-absorption x distance) inside, for \
+                 photons and eye paths alike (caustics behind it take its colour)",
+                tinted.join(", ")
+            ));
+        }
         if !global && !caustic {
             reasons.push("photon tracing: skipped (no photon set to fill)".to_string());
         }

@@ -183,6 +183,13 @@ impl Tracer<'_> {
             let Some(hit) = self.scene.geometry.intersect(&ray) else {
                 return;
             };
+            // Beer-Lambert along the segment just traced, when it ran inside absorbing glass:
+            // a deterministic factor, so the roulettes below (relative to the flux they
+            // receive) stay unbiased.
+            flux *= self.scene.transmittance_to(&hit, &ray);
+            if !flux.cmpgt(Vec3::ZERO).any() {
+                return;
+            }
             let (uc, u) = (rng.uniform(), rng.uniform2());
             let Some(bsdf) = self.scene.bsdf_at(&hit) else {
                 return;

@@ -121,6 +121,8 @@ impl<'a> PathTracer<'a> {
         let mut from_diffuse: Option<(Vec3, f32)> = None;
         let mut bounces = 0u32;
         while let Some(hit) = geometry.intersect(&ray) {
+            // Beer-Lambert along the segment just traced, when it ran inside absorbing glass.
+            beta *= self.scene.transmittance_to(&hit, &ray);
             // Emission found by the path itself.
             if let Some(light) = lights.light_of(hit.prim) {
                 let le = lights.le(light, ray.d);

@@ -174,6 +174,11 @@ pub(crate) fn first_diffuse(
         let Some(hit) = scene.geometry.intersect(&b.ray) else {
             continue;
         };
+        // Beer-Lambert along the segment just traced, when it ran inside absorbing glass.
+        let b = Branch {
+            beta: b.beta * scene.transmittance_to(&hit, &b.ray),
+            ..b
+        };
         if (count_emission || b.glossy)
             && let Some(light) = lights.light_of(hit.prim)
         {

@@ -281,8 +281,15 @@ pub enum MaterialDesc {
     Metal {
         reflectance: [f32; 3],
     },
+    /// Smooth glass of index `ior`: `transmittance` (each in [0, 1]) scales refracted light
+    /// at every crossing (Mitsuba 3's `specular_transmittance`); `absorption` (>= 0, per
+    /// scene unit) attenuates light inside by `exp(-absorption * distance)` (Beer-Lambert).
     Dielectric {
         ior: f32,
+        #[serde(default = "one3", skip_serializing_if = "is_one3")]
+        transmittance: [f32; 3],
+        #[serde(default, skip_serializing_if = "is_zero3")]
+        absorption: [f32; 3],
     },
     /// A Lambertian `albedo` plus a GGX lobe of constant reflectance `specular` (no Fresnel)
     /// and roughness `alpha`: MTL `illum 2` given directly.
@@ -306,13 +313,28 @@ pub enum MaterialDesc {
         #[serde(default)]
         k: Option<[f32; 3]>,
     },
-    /// Rough glass (GGX, roughness `alpha`) of index `ior` (Mitsuba 3's `roughdielectric`).
+    /// Rough glass (GGX, roughness `alpha`) of index `ior` (Mitsuba 3's `roughdielectric`),
+    /// with the smooth glass's `transmittance` and `absorption`.
     RoughDielectric {
         ior: f32,
         alpha: f32,
+        #[serde(default = "one3", skip_serializing_if = "is_one3")]
+        transmittance: [f32; 3],
+        #[serde(default, skip_serializing_if = "is_zero3")]
+        absorption: [f32; 3],
     },
 }
 
 fn one3() -> [f32; 3] {
     [1.0; 3]
+}
+
+// Defaults are not written back: the hashes of a scene without coloured glass (its caches,
+// its images' metadata) stay what they were before the keys existed.
+fn is_one3(v: &[f32; 3]) -> bool {
+    *v == [1.0; 3]
+}
+
+fn is_zero3(v: &[f32; 3]) -> bool {
+    *v == [0.0; 3]
 }

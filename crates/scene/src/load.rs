@@ -65,6 +65,9 @@ pub struct Scene {
     /// [`Scene::bsdf_at`] multiplies its lookup into the diffuse lobe.
     pub albedo_maps: Vec<Option<AlbedoMap>>,
     pub textures: Vec<Texture>,
+    /// Beer-Lambert absorption coefficient inside each material (zero but for absorbing
+    /// glass), built once for every pass ([`Scene::transmittance_to`]).
+    pub absorption: Vec<Vec3>,
     pub camera: Camera,
     /// FNV-1a hash of the scene file and every file it names, in order.
     pub content_hash: u64,
@@ -277,9 +280,18 @@ impl<'a> Builder<'a> {
                     },
                     Vec3::ZERO,
                 ),
-                MaterialDesc::Dielectric { ior } => {
-                    (Material::Dielectric { ior: *ior }, Vec3::ZERO)
-                }
+                MaterialDesc::Dielectric {
+                    ior,
+                    transmittance,
+                    absorption,
+                } => (
+                    Material::Dielectric {
+                        ior: *ior,
+                        transmittance: Vec3::from(*transmittance),
+                        absorption: Vec3::from(*absorption),
+                    },
+                    Vec3::ZERO,
+                ),
                 MaterialDesc::Glossy {
                     albedo,
                     specular,
@@ -312,10 +324,17 @@ impl<'a> Builder<'a> {
                     },
                     Vec3::ZERO,
                 ),
-                MaterialDesc::RoughDielectric { ior, alpha } => (
+                MaterialDesc::RoughDielectric {
+                    ior,
+                    alpha,
+                    transmittance,
+                    absorption,
+                } => (
                     Material::RoughDielectric {
                         ior: *ior,
                         alpha: *alpha,
+                        transmittance: Vec3::from(*transmittance),
+                        absorption: Vec3::from(*absorption),
                     },
                     Vec3::ZERO,
                 ),
@@ -574,6 +593,7 @@ impl<'a> Builder<'a> {
             bsdfs: self.materials.iter().map(crate::world::bsdf_of).collect(),
             albedo_maps: self.albedo_maps,
             textures: self.textures,
+            absorption: self.materials.iter().map(Material::absorption).collect(),
             warnings: self.warnings,
             materials: self.materials,
             material_names: self.names,
@@ -590,12 +610,48 @@ impl<'a> Builder<'a> {
 
     fn validate_materials(&self) -> Result<(), SceneError> {
         for (name, m) in self.names.iter().zip(&self.materials) {
+            // Glass's own keys first, each named alone.
+            if let Material::Dielectric {
+                transmittance,
+                absorption,
+                ..
+            }
+            | Material::RoughDielectric {
+                transmittance,
+                absorption,
+                ..
+            } = m
+            {
+                if !in_unit(*transmittance) {
+                    return Err(self.err(format!(
+                        "material `{name}`: transmittance {:?} must lie in [0, 1] in each channel",
+                        transmittance.to_array()
+                    )));
+                }
+                if !non_negative(*absorption) {
+                    return Err(self.err(format!(
+                        "material `{name}`: absorption {:?} must be finite and >= 0 in each \
+                         channel (per scene unit)",
+                        absorption.to_array()
+                    )));
+                }
+            }
             let ok = match m {
                 Material::Lambertian { albedo } => in_unit(*albedo),
                 Material::Mirror { reflectance } | Material::Metal { reflectance } => {
                     in_unit(*reflectance)
                 }
-                Material::Dielectric { ior } => ior.is_finite() && *ior > 0.0 && *ior < 10.0,
+                Material::Dielectric {
+                    ior,
+                    transmittance,
+                    absorption,
+                } => {
+                    ior.is_finite()
+                        && *ior > 0.0
+                        && *ior < 10.0
+                        && in_unit(*transmittance)
+                        && non_negative(*absorption)
+                }
                 Material::Glossy {
                     albedo,
                     specular,
@@ -621,15 +677,26 @@ impl<'a> Builder<'a> {
                                 && k.min_element() >= 0.0
                         })
                 }
-                Material::RoughDielectric { ior, alpha } => {
-                    ior.is_finite() && *ior > 0.0 && *ior < 10.0 && ALPHA_RANGE.contains(alpha)
+                Material::RoughDielectric {
+                    ior,
+                    alpha,
+                    transmittance,
+                    absorption,
+                } => {
+                    ior.is_finite()
+                        && *ior > 0.0
+                        && *ior < 10.0
+                        && ALPHA_RANGE.contains(alpha)
+                        && in_unit(*transmittance)
+                        && non_negative(*absorption)
                 }
             };
             if !ok {
                 return Err(self.err(format!(
-                    "material `{name}`: albedo/reflectance (and albedo + specular) must lie in \
-                     [0, 1], ior in (0, 10), alpha in [1e-4, 1], eta > 0 and k >= 0 given \
-                     together (got {m:?})"
+                    "material `{name}`: albedo/reflectance/transmittance (and albedo + \
+                     specular) must lie in [0, 1], ior in (0, 10), alpha in [1e-4, 1], \
+                     absorption be finite and >= 0, eta > 0 and k >= 0 given together (got \
+                     {m:?})"
                 )));
             }
         }
@@ -1026,6 +1093,10 @@ fn in_unit(v: Vec3) -> bool {
     v.is_finite() && v.min_element() >= 0.0 && v.max_element() <= 1.0
 }
 
+fn non_negative(v: Vec3) -> bool {
+    v.is_finite() && v.min_element() >= 0.0
+}
+
 /// An MTL material turned into one of photonflow's: the material, its emission, and a line
 /// for each thing it approximates (printed as `warning:` lines).
 struct Converted {
@@ -1169,13 +1240,13 @@ fn convert_mtl(m: &tobj::Material, emission: EmissionSource) -> Result<Converted
              glass (illum 4, 6, 7 or 9 with `Ni`)"
         ));
     }
-    if tf.is_some_and(|t| t != Vec3::ONE) {
-        if glass_illum || course_glass {
-            return Err(format!(
-                "`Tf {}`: coloured glass is not rendered yet",
-                tf_text
-            ));
-        }
+    let glassy = glass_illum || course_glass;
+    if glassy && tf.is_some_and(|t| !in_unit(t)) {
+        return Err(format!(
+            "`Tf {tf_text}`: the transmission filter of glass must lie in [0, 1] in each channel"
+        ));
+    }
+    if !glassy && tf.is_some_and(|t| t != Vec3::ONE) {
         warnings.push(format!(
             "`Tf {}`: a transmission filter is read only for glass; illum {} is opaque",
             tf_text,
@@ -1223,7 +1294,13 @@ fn convert_mtl(m: &tobj::Material, emission: EmissionSource) -> Result<Converted
                 ks.x, ks.y, ks.z
             ));
         }
-        Material::Dielectric { ior }
+        // `Tf` scales refracted light at every crossing: Mitsuba 3's
+        // `specular_transmittance`, which the peers' mapping gives it too.
+        Material::Dielectric {
+            ior,
+            transmittance: tf.unwrap_or(Vec3::ONE),
+            absorption: Vec3::ZERO,
+        }
     };
     let mat = match illum {
         _ if course_glass => glass(&mut warnings, ""),

@@ -57,7 +57,7 @@ fn tessellated_cornell_matches_the_worksheet_scene() {
     );
     assert_eq!(
         s.materials[s.material_of("glass").unwrap() as usize],
-        Material::Dielectric { ior: 1.5 }
+        Material::glass(1.5)
     );
     assert_eq!(
         s.materials[s.material_of("red").unwrap() as usize],
@@ -140,6 +140,7 @@ fn every_scene_in_the_tree_loads() {
     for rel in [
         "cornell-spheres/tessellated.toml",
         "cornell-spheres/analytic.toml",
+        "cornell-spheres/coloured-glass.toml",
         "furnace/furnace.toml",
         "plane-light/plane-light.toml",
         "corner/corner.toml",
@@ -849,18 +850,12 @@ fn mtl_files_follow_the_documented_table() {
         "`Kd 0.5 0.5 0.5` is not used",
     );
     // Glass.
-    assert_eq!(
-        quiet("Ni 1.33\nillum 7"),
-        Material::Dielectric { ior: 1.33 }
-    );
-    assert_eq!(quiet("Ni 1.5\nillum 4"), Material::Dielectric { ior: 1.5 });
-    assert_eq!(
-        quiet("Kd 0.5 0.5 0.5\nNi 1.4\nd 0.2"),
-        Material::Dielectric { ior: 1.4 }
-    );
+    assert_eq!(quiet("Ni 1.33\nillum 7"), Material::glass(1.33));
+    assert_eq!(quiet("Ni 1.5\nillum 4"), Material::glass(1.5));
+    assert_eq!(quiet("Kd 0.5 0.5 0.5\nNi 1.4\nd 0.2"), Material::glass(1.4));
     assert_eq!(
         warned("illum 4", "drawn with index 1.5"),
-        Material::Dielectric { ior: 1.5 }
+        Material::glass(1.5)
     );
     warned("Ni 1.5\nillum 6", "illum 6");
     warned("Ni 1.5\nillum 9", "illum 9");
@@ -868,10 +863,7 @@ fn mtl_files_follow_the_documented_table() {
         "Ni 1.5\nKs 0.5 0.5 0.5\nillum 7",
         "glass reflects by the Fresnel",
     );
-    assert_eq!(
-        quiet("Ni 1.5\nTr 0.9\nillum 7"),
-        Material::Dielectric { ior: 1.5 }
-    );
+    assert_eq!(quiet("Ni 1.5\nTr 0.9\nillum 7"), Material::glass(1.5));
     // Course metal.
     assert_eq!(
         quiet("Ks 0.96 0.98 0.96\nillum 11"),
@@ -896,7 +888,28 @@ fn mtl_files_follow_the_documented_table() {
         "ke",
         "map_Ks",
     );
-    refused("Ni 1.5\nTf 0.9 0.5 0.5\nillum 7", "ke", "Tf 0.9 0.5 0.5");
+    // Coloured glass: `Tf` is the transmittance (grey with one number); out of [0, 1] refused.
+    let tinted = |ior: f32, t: Vec3| Material::Dielectric {
+        ior,
+        transmittance: t,
+        absorption: Vec3::ZERO,
+    };
+    assert_eq!(
+        quiet("Ni 1.5\nTf 0.9 0.5 0.5\nillum 7"),
+        tinted(1.5, Vec3::new(0.9, 0.5, 0.5))
+    );
+    assert_eq!(quiet("Ni 1.5\nTf 0.25\nillum 4"), tinted(1.5, v(0.25)));
+    assert_eq!(
+        quiet("Kd 0.5 0.5 0.5\nNi 1.4\nd 0.2\nTf 0.2 0.4 0.6"),
+        tinted(1.4, Vec3::new(0.2, 0.4, 0.6))
+    );
+    refused("Ni 1.5\nTf 1.2 0.5 0.5\nillum 7", "ke", "`Tf 1.2 0.5 0.5`");
+    refused(
+        "Ni 1.5\nTf -0.1 0.5 0.5\nillum 9",
+        "ke",
+        "must lie in [0, 1]",
+    );
+    refused("Ni 1.5\nTf nan 0.5 0.5\nillum 4", "ke", "`Tf nan 0.5 0.5`");
     refused("Kd 0.5 0.5 0.5\nd 0.5", "ke", "opacity 0.5");
     refused("Kd 0.5 0.5 0.5\nTr 0.5", "ke", "opacity 0.5");
     refused("Kd 0.5 0.5 0.5\nPr 0.5", "ke", "`Pr 0.5`");
@@ -1196,4 +1209,97 @@ fn missing_or_broken_textures_are_named() {
         e.file.ends_with("s.toml") && e.problem.contains("texture `gone.png`"),
         "{e}"
     );
+}
+
+/// The scene file's coloured and absorbing glass: keys, defaults, the hash of clear glass
+/// unchanged by writing the defaults out, and Beer-Lambert read at the surface a segment
+/// ends on, from the inside only.
+#[test]
+fn glass_transmittance_and_absorption_keys() {
+    let path = scenes_dir().join("cornell-spheres/analytic.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let a = Scene::from_toml(&path, &text).unwrap();
+    let glass = a.material_of("glass").unwrap();
+    assert_eq!(a.materials[glass as usize], Material::glass(1.5));
+    assert_eq!(a.absorption[glass as usize], Vec3::ZERO);
+    let defaults = text.replace(
+        "ior = 1.5",
+        "ior = 1.5\ntransmittance = [1, 1, 1]\nabsorption = [0, 0, 0]",
+    );
+    let b = Scene::from_toml(&path, &defaults).unwrap();
+    assert_eq!(
+        (a.photon_hash, a.image_hash, a.view_hash),
+        (b.photon_hash, b.image_hash, b.view_hash),
+        "clear glass written out in full hashes as before"
+    );
+    let coloured = text.replace(
+        "ior = 1.5",
+        "ior = 1.5\ntransmittance = [0.9, 0.6, 0.3]\nabsorption = [0.5, 0.25, 0]",
+    );
+    let c = Scene::from_toml(&path, &coloured).unwrap();
+    assert_eq!(
+        c.materials[glass as usize],
+        Material::Dielectric {
+            ior: 1.5,
+            transmittance: Vec3::new(0.9, 0.6, 0.3),
+            absorption: Vec3::new(0.5, 0.25, 0.0),
+        }
+    );
+    assert_ne!(a.photon_hash, c.photon_hash);
+    let Some(bsdf::Bsdf::Dielectric(d)) = c.bsdf(glass) else {
+        panic!("not a dielectric")
+    };
+    assert_eq!(d.transmittance, Vec3::new(0.9, 0.6, 0.3));
+
+    // The glass sphere (centre (-3.272, 2.29, -6.2395), radius 2.25): a chord through its
+    // centre from inside is attenuated by exp(-σ 2r); the same segment arriving from outside,
+    // or ending on the (non-absorbing) wall, is not.
+    let centre = Vec3::new(-3.272, 2.29, -6.2395);
+    let from_inside = geom::Ray::new(centre - Vec3::new(0.0, 0.0, 2.2), Vec3::new(0.0, 0.0, 2.0));
+    let hit = c.geometry.intersect(&from_inside).unwrap();
+    assert_eq!(hit.material, glass);
+    let t = hit.t * 2.0;
+    assert!((t - 4.45).abs() < 1e-4, "{t}");
+    let want = (-Vec3::new(0.5, 0.25, 0.0) * t).exp();
+    let got = c.transmittance_to(&hit, &from_inside);
+    assert!((got - want).abs().max_element() < 1e-6, "{got} vs {want}");
+    let from_outside = geom::Ray::new(centre + Vec3::new(0.0, 0.0, 4.0), Vec3::NEG_Z);
+    let hit = c.geometry.intersect(&from_outside).unwrap();
+    assert_eq!(hit.material, glass);
+    assert_eq!(c.transmittance_to(&hit, &from_outside), Vec3::ONE);
+    // Rough glass takes the same keys.
+    let rough = text.replace(
+        "type = \"dielectric\"\nior = 1.5",
+        "type = \"rough_dielectric\"\nior = 1.5\nalpha = 0.1\nabsorption = [1, 2, 3]",
+    );
+    let r = Scene::from_toml(&path, &rough).unwrap();
+    assert_eq!(r.absorption[glass as usize], Vec3::new(1.0, 2.0, 3.0));
+}
+
+#[test]
+fn glass_keys_out_of_range_name_the_file_and_material() {
+    for (key, problem) in [
+        ("absorption = [-0.5, 0, 0]", "absorption"),
+        ("absorption = [nan, 0, 0]", "absorption"),
+        ("absorption = [inf, 0, 0]", "absorption"),
+        ("transmittance = [1.5, 1, 1]", "transmittance"),
+        ("transmittance = [-0.1, 1, 1]", "transmittance"),
+    ] {
+        let toml = format!(
+            "{}[material.tinted]\ntype = \"dielectric\"\nior = 1.5\n{key}\n",
+            scene_toml("a.obj")
+        );
+        error_of(
+            "glass-keys",
+            &[("s.toml", &toml), ("a.obj", GOOD_OBJ), ("m.mtl", GOOD_MTL)],
+            "s.toml",
+            "material `tinted`",
+        );
+        let dir = Scratch::new(
+            "glass-keys-2",
+            &[("s.toml", &toml), ("a.obj", GOOD_OBJ), ("m.mtl", GOOD_MTL)],
+        );
+        let e = Scene::load(dir.path("s.toml")).err().unwrap().to_string();
+        assert!(e.contains(problem) && !e.contains('\n'), "{key}: {e}");
+    }
 }

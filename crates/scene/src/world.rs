@@ -5,7 +5,7 @@
 
 use crate::{Material, Scene};
 use bsdf::{Bsdf, Dielectric, Glossy, Lambertian, Metal, Mirror, RoughConductor, RoughDielectric};
-use geom::{Hit, Prim};
+use geom::{Hit, Prim, Ray};
 use glam::{Vec2, Vec3};
 
 /// Set in a surface id for a sphere; clear for a triangle.
@@ -20,7 +20,15 @@ pub fn bsdf_of(m: &Material) -> Option<Bsdf> {
         }
         Material::Mirror { reflectance } => Some(Mirror { reflectance }.into()),
         Material::Metal { reflectance } => Some(Metal { reflectance }.into()),
-        Material::Dielectric { ior } => Some(Dielectric { eta: ior }.into()),
+        Material::Dielectric {
+            ior, transmittance, ..
+        } => Some(
+            Dielectric {
+                eta: ior,
+                transmittance,
+            }
+            .into(),
+        ),
         Material::Glossy {
             albedo,
             specular,
@@ -45,9 +53,19 @@ pub fn bsdf_of(m: &Material) -> Option<Bsdf> {
             }
             .into(),
         ),
-        Material::RoughDielectric { ior, alpha } => {
-            Some(RoughDielectric { eta: ior, alpha }.into())
-        }
+        Material::RoughDielectric {
+            ior,
+            alpha,
+            transmittance,
+            ..
+        } => Some(
+            RoughDielectric {
+                eta: ior,
+                alpha,
+                transmittance,
+            }
+            .into(),
+        ),
     }
 }
 
@@ -117,6 +135,28 @@ impl Scene {
         self.bsdfs[material as usize]
             .and_then(|b| b.diffuse_albedo())
             .is_some_and(|a| a.max_element() > 0.0)
+    }
+
+    /// Beer-Lambert transmittance of the segment of `ray` that ends at `hit` (pbrt-v4
+    /// §11.1, Beer's law: `exp(-σa t)` per channel, `t` the segment's length): not 1 only when the
+    /// segment ends on an absorbing glass from its inside, i.e. `ray.d` points along the
+    /// geometric normal, which faces outwards (spheres) or to the shading normal's side
+    /// (triangles), the side the dielectric BSDFs take as outside.
+    ///
+    /// Media are bounded by their glass surfaces and read from the surface a segment ends
+    /// on, with no medium carried along the path (pbrt-v4's medium interfaces, without the
+    /// medium a ray carries): every pass calls this one function at every hit, so the path
+    /// tracer, the eye vertices and the photon tracers agree. Limitation: light travelling
+    /// inside glass to something else inside it (an object or a light within the glass, or a
+    /// second glass touching it) is not attenuated on that segment, and a camera inside
+    /// glass sees the first segment unattenuated unless it ends on that glass.
+    #[inline]
+    pub fn transmittance_to(&self, hit: &Hit, ray: &Ray) -> Vec3 {
+        let sigma = self.absorption[hit.material as usize];
+        if sigma == Vec3::ZERO || ray.d.dot(hit.point.n) <= 0.0 {
+            return Vec3::ONE;
+        }
+        (-sigma * (hit.t * ray.d.length())).exp()
     }
 
     /// Unit geometric normal of surface `id` (see [`surface_id`]) at a point `p` on it, or

@@ -31,7 +31,7 @@ fn rough_gold(alpha: f32) -> Bsdf {
 }
 
 fn rough_glass(alpha: f32) -> Bsdf {
-    RoughDielectric { eta: 1.5, alpha }.into()
+    RoughDielectric::clear(1.5, alpha).into()
 }
 
 fn glossy(alpha: f32) -> Bsdf {
@@ -81,7 +81,7 @@ fn glossy_models_classify_their_lobes() {
     .into();
     assert_eq!(lambert.diffuse_albedo(), Some(Vec3::splat(0.4)));
     assert!(!lambert.is_glossy() && lambert.roughness().is_none());
-    assert!(!Bsdf::from(Dielectric { eta: 1.5 }).is_glossy());
+    assert!(!Bsdf::from(Dielectric::clear(1.5)).is_glossy());
     // Degenerate roughness is clamped, as Mitsuba 3 does, and stays finite.
     assert_eq!(rough_glass(0.0).roughness(), Some(MIN_ALPHA));
     assert_eq!(TrowbridgeReitz::new(-1.0).alpha_x, MIN_ALPHA);
