@@ -18,7 +18,8 @@ use glam::Vec3;
 /// | `Ke` | emission (`emission = "ke"`, the default) |
 /// | `Ka` | emission with `emission = "ka"` (the course's convention; a `Ke` too is refused), else the ambient colour, which a physically based renderer has no use for |
 /// | `Tf` | on glass, the transmittance: a factor on the refracted light at every crossing, each in [0, 1] (out of range: refused); warning elsewhere. Absorption inside glass has no MTL key: the scene file's `absorption` |
-/// | `map_Kd`, `map_Ks`, `map_d` | refused (textures: not yet) |
+/// | `map_Kd` | the diffuse albedo's texture times `Kd` (the texture alone without `Kd`), on illum 0-2 (warning elsewhere); read at the OBJ's `vt`, bilinear, repeated (`Scene::bsdf_at`); a missing or unreadable image, or texture options, refused |
+/// | `map_Ks`, `map_d` | refused |
 /// | `bump`, `map_Bump`, `map_Ns`, `refl`, `disp`, `decal` | warning: drawn without |
 /// | `Pr`, `Pm`, `Ps`, `Pc`, `Pcr`, `aniso`, `anisor`, `map_Pr`, `map_Pm` (PBR extension) | refused |
 #[derive(Clone, Debug, PartialEq)]
