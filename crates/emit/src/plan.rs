@@ -132,6 +132,15 @@ impl Plan {
                 tinted.join(", ")
             ));
         }
+        let textured = names(&|m, _| scene.albedo_maps[m as usize].is_some());
+        if !textured.is_empty() {
+            reasons.push(format!(
+                "textured surfaces ({}): every method reads the albedo from the texture where \
+                 light meets them: eye paths, photons scattering off them, the estimates and \
+                 splats at their eye vertices",
+                textured.join(", ")
+            ));
+        }
         if !global && !caustic {
             reasons.push("photon tracing: skipped (no photon set to fill)".to_string());
         }

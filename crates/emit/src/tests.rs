@@ -120,8 +120,21 @@ fn cornell_plans_both_sets() {
         !text.contains("light,") && !text.contains(", light"),
         "{text}"
     );
-    // Clear glass: no line about coloured glass.
+    // Clear glass, no texture: no line about either.
     assert!(!text.contains("coloured"), "{text}");
+    assert!(!text.contains("textured"), "{text}");
+}
+
+#[test]
+fn the_plan_names_textured_surfaces() {
+    let p = plan(
+        &load("cornell-textured/textured-floor.toml"),
+        &EmitParams::default(),
+    );
+    let text = p.to_string();
+    let lines: Vec<&str> = text.lines().filter(|l| l.contains("textured")).collect();
+    assert_eq!(lines.len(), 1, "{text}");
+    assert!(lines[0].contains("textured surfaces (floor)"), "{text}");
 }
 
 #[test]
