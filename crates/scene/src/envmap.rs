@@ -164,7 +164,9 @@ impl EnvMap {
     /// Each patch weighs `∫ luminance dω` over it, the `sin θ` of `dω` integrated exactly
     /// rather than taken at the patch centre, and within a patch `cos θ` (not `θ`) is uniform:
     /// so the density is constant over every patch, and exactly `1/(4π)` for a uniform map
-    /// (pbrt-v4's and Mitsuba's warps take `sin θ` at the nodes and leave a `1/sin θ` pole).
+    /// (pbrt-v3's lat-long light and Mitsuba 3's `envmap` take `sin θ` at a point and so keep
+    /// a `1/sin θ` factor in the density). Mitsuba's warp is bilinear (`Hierarchical2D`), this
+    /// one piecewise constant: the densities differ, the estimates converge to the same image.
     #[inline]
     pub fn sample(&self, u: [f32; 2]) -> (Vec3, Vec3, f32) {
         match &self.source {
