@@ -17,7 +17,7 @@ pub mod warp;
 pub use frame::Frame;
 pub use rng::{Rng, mix64};
 pub use sampler::{Sampler, SobolSampler};
-pub use warp::{Distribution1D, power_heuristic};
+pub use warp::{Distribution1D, Distribution2D, power_heuristic};
 
 #[cfg(test)]
 mod tests;

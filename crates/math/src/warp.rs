@@ -264,6 +264,116 @@ impl Distribution1D {
     }
 }
 
+/// A piecewise-constant density on `[0, 1]^2` from an `nu x nv` grid of non-negative weights:
+/// a marginal [`Distribution1D`] over the rows picks `v`, then that row's conditional picks
+/// `u` (pbrt-v4 §A.5.6, `PiecewiseConstant2D`). It drives importance sampling of
+/// environment maps, where a cell is a texel (pbrt-v4 §12.5.2).
+#[derive(Clone, Debug)]
+pub struct Distribution2D {
+    nu: usize,
+    nv: usize,
+    /// One distribution over the columns per row.
+    conditional: Vec<Distribution1D>,
+    /// Over the rows, by row sums.
+    marginal: Distribution1D,
+}
+
+/// The cell of `x` in `[0, 1]` among `n` equal cells. Sampling, pdf and inversion all find
+/// cells through this one function, so a sampled point's pdf is the pdf its sample reported.
+#[inline]
+fn cell_of(x: f32, n: usize) -> usize {
+    ((x.max(0.0) as f64 * n as f64) as usize).min(n - 1)
+}
+
+/// `(cell + t) / n` in `f32`, stepped by an ulp if rounding moved it into a neighbour cell
+/// (e.g. `1 + ONE_MINUS_EPSILON` rounds to 2): a zero-weight neighbour would report pdf 0.
+#[inline]
+fn point_in_cell(cell: usize, t: f32, n: usize) -> f32 {
+    let mut x = ((cell as f64 + t as f64) / n as f64) as f32;
+    while cell_of(x, n) > cell {
+        x = f32::from_bits(x.to_bits() - 1);
+    }
+    while cell_of(x, n) < cell {
+        x = f32::from_bits(x.to_bits() + 1);
+    }
+    x
+}
+
+impl Distribution2D {
+    /// `weights` is row-major, `weights[v * nu + u]`, row `v` covering
+    /// `[v / nv, (v + 1) / nv]`. `None` when every weight is 0: there is nothing to sample,
+    /// and unlike [`Distribution1D`] a uniform fallback would hide a black environment map.
+    /// Panics, as [`Distribution1D::new`] does, on an empty grid, a length that is not
+    /// `nu * nv`, or a negative or non-finite weight: those are caller bugs.
+    pub fn new(weights: &[f64], nu: usize, nv: usize) -> Option<Distribution2D> {
+        assert!(nu > 0 && nv > 0, "Distribution2D needs a non-empty grid");
+        assert_eq!(
+            weights.len(),
+            nu * nv,
+            "Distribution2D needs nu * nv weights"
+        );
+        let conditional: Vec<Distribution1D> =
+            weights.chunks_exact(nu).map(Distribution1D::new).collect();
+        let rows: Vec<f64> = conditional.iter().map(Distribution1D::total).collect();
+        if rows.iter().sum::<f64>() <= 0.0 {
+            return None;
+        }
+        Some(Distribution2D {
+            nu,
+            nv,
+            conditional,
+            marginal: Distribution1D::new(&rows),
+        })
+    }
+
+    /// Grid size `(nu, nv)`.
+    pub fn resolution(&self) -> (usize, usize) {
+        (self.nu, self.nv)
+    }
+
+    /// Sum of all weights.
+    pub fn total(&self) -> f64 {
+        self.marginal.total()
+    }
+
+    /// A point of `[0, 1]^2` and its density with respect to area. `u[1]` picks the row and
+    /// `u[0]` the column, so a stratified `u[0]` stays stratified within a row.
+    #[inline]
+    pub fn sample(&self, u: [f32; 2]) -> (Vec2, f32) {
+        let (row, pmf_row, tv) = self.marginal.sample(u[1]);
+        let (col, pmf_col, tu) = self.conditional[row].sample(u[0]);
+        let p = Vec2::new(
+            point_in_cell(col, tu, self.nu),
+            point_in_cell(row, tv, self.nv),
+        );
+        (p, pmf_row * pmf_col * (self.nu * self.nv) as f32)
+    }
+
+    /// Density of [`Distribution2D::sample`] at `p`: the cell's probability over its area
+    /// `1 / (nu nv)`; 0 outside the square.
+    #[inline]
+    pub fn pdf(&self, p: Vec2) -> f32 {
+        if !(0.0..=1.0).contains(&p.x) || !(0.0..=1.0).contains(&p.y) {
+            return 0.0;
+        }
+        let (col, row) = (cell_of(p.x, self.nu), cell_of(p.y, self.nv));
+        self.marginal.pmf(row) * self.conditional[row].pmf(col) * (self.nu * self.nv) as f32
+    }
+
+    /// Inverse of [`Distribution2D::sample`]: the `u` that lands on `p`.
+    #[inline]
+    pub fn invert(&self, p: Vec2) -> [f32; 2] {
+        let p = p.clamp(Vec2::ZERO, Vec2::ONE);
+        let (col, row) = (cell_of(p.x, self.nu), cell_of(p.y, self.nv));
+        let tu = (p.x as f64 * self.nu as f64 - col as f64).clamp(0.0, 1.0) as f32;
+        let tv = (p.y as f64 * self.nv as f64 - row as f64).clamp(0.0, 1.0) as f32;
+        [
+            self.conditional[row].invert(col, tu),
+            self.marginal.invert(row, tv),
+        ]
+    }
+}
+
 // --- Multiple importance sampling -------------------------------------------------------
 
 /// Veach's power heuristic with β = 2 (Veach 1997 §9.2.4; pbrt-v4 §2.2.3): the MIS weight of a

@@ -11,6 +11,7 @@
 //! and nothing else.
 
 mod camera;
+mod envmap;
 mod error;
 mod file;
 mod lights;
@@ -21,6 +22,7 @@ mod texture;
 mod world;
 
 pub use camera::Camera;
+pub use envmap::EnvMap;
 pub use error::SceneError;
 pub use file::{
     CameraDesc, EmissionSource, MaterialDesc, MeshDesc, Method, NormalMode, RenderSettings,

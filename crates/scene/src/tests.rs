@@ -1303,3 +1303,6 @@ fn glass_keys_out_of_range_name_the_file_and_material() {
         assert!(e.contains(problem) && !e.contains('\n'), "{key}: {e}");
     }
 }
+
+// The environment light's tests live in tests/envmap.rs.
+mod envmap;

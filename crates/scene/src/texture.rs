@@ -38,10 +38,10 @@ impl Texture {
             let mut r = image::ImageReader::new(std::io::Cursor::new(bytes))
                 .with_guessed_format()
                 .map_err(|e| format!("cannot read it: {e}"))?;
-            if r.format().is_none() {
-                if let Ok(f) = image::ImageFormat::from_path(name) {
-                    r.set_format(f);
-                }
+            if r.format().is_none()
+                && let Ok(f) = image::ImageFormat::from_path(name)
+            {
+                r.set_format(f);
             }
             Ok::<_, String>(r)
         };

@@ -1,6 +1,6 @@
-use crate::chi2::{ALPHA, pearson};
+use crate::chi2::{ALPHA, chi2_test, pearson};
 use crate::warp::*;
-use crate::{Distribution1D, Rng, power_heuristic};
+use crate::{Distribution1D, Distribution2D, Rng, power_heuristic};
 use glam::{Vec2, Vec3};
 
 /// Distance between two points of the unit square, treating `u[1]` as periodic when the
@@ -206,4 +206,120 @@ fn power_heuristic_matches_veach() {
     assert!((power_heuristic(2, 1.0, 1, 1.0) - 0.8).abs() < 1e-7);
     assert_eq!(power_heuristic(1, f32::INFINITY, 1, 1.0), 1.0);
     assert_eq!(power_heuristic(1, 0.0, 1, 0.0), 0.0);
+}
+
+/// A 5 x 6 grid with an empty row, an empty column (in one row) and a 1000:1 range.
+const GRID_NU: usize = 5;
+const GRID_NV: usize = 6;
+#[rustfmt::skip]
+const GRID: [f64; GRID_NU * GRID_NV] = [
+    1.0, 2.0, 0.0, 4.0, 0.5,
+    0.0, 0.0, 0.0, 0.0, 0.0,
+    3.0, 1.0, 7.0, 0.2, 1.0,
+    0.1, 0.1, 1e-3, 0.1, 0.1,
+    9.0, 0.0, 0.0, 2.0, 5.0,
+    1.0, 1.0, 1.0, 1.0, 1.0,
+];
+
+/// The unit square onto the sphere by the area-preserving uniform-sphere warp (area 4π),
+/// so the crate's direction harness tests a square's density: with `theta_res` a multiple of
+/// `nu` and `phi_res` of `nv`, the harness's cells tile the grid's cells exactly.
+fn chi2_of_distribution2d(d: &Distribution2D, pdf_of: impl Fn(Vec2) -> f32) -> Result<(), String> {
+    chi2_test(
+        9 * GRID_NU,
+        10 * GRID_NV,
+        400_000,
+        27,
+        |rng| {
+            let (p, pdf) = d.sample(rng.uniform2());
+            assert_eq!(pdf, d.pdf(p), "sample's pdf against pdf() at {p}");
+            Some(sample_uniform_sphere([p.x, p.y]))
+        },
+        |w| {
+            let u = invert_uniform_sphere(w);
+            pdf_of(Vec2::new(u[0], u[1])) as f64 / (4.0 * std::f64::consts::PI)
+        },
+    )
+}
+
+#[test]
+fn distribution2d_samples_in_proportion_chi2() {
+    let d = Distribution2D::new(&GRID, GRID_NU, GRID_NV).unwrap();
+    assert_eq!(d.resolution(), (GRID_NU, GRID_NV));
+    chi2_of_distribution2d(&d, |p| d.pdf(p)).unwrap();
+    // The harness notices a wrong density: the same grid transposed row for row.
+    let mut flipped = GRID;
+    flipped.reverse();
+    let wrong = Distribution2D::new(&flipped, GRID_NU, GRID_NV).unwrap();
+    assert!(chi2_of_distribution2d(&d, |p| wrong.pdf(p)).is_err());
+}
+
+#[test]
+fn distribution2d_pdf_is_the_normalised_weight_and_integrates_to_one() {
+    let d = Distribution2D::new(&GRID, GRID_NU, GRID_NV).unwrap();
+    let total: f64 = GRID.iter().sum();
+    assert!((d.total() - total).abs() < 1e-12 * total);
+    for (i, w) in GRID.iter().enumerate() {
+        let (col, row) = (i % GRID_NU, i / GRID_NU);
+        let centre = Vec2::new(
+            (col as f32 + 0.5) / GRID_NU as f32,
+            (row as f32 + 0.5) / GRID_NV as f32,
+        );
+        let want = w / total * (GRID_NU * GRID_NV) as f64;
+        assert!(
+            (d.pdf(centre) as f64 - want).abs() < 1e-6 * want.max(1.0),
+            "cell ({col}, {row})"
+        );
+    }
+    // Midpoint rule on a grid 20 times finer: exact for a piecewise-constant density.
+    let (n, m) = (20 * GRID_NU, 20 * GRID_NV);
+    let mut sum = 0.0f64;
+    for j in 0..m {
+        for i in 0..n {
+            let p = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / m as f32);
+            sum += d.pdf(p) as f64;
+        }
+    }
+    let integral = sum / (n * m) as f64;
+    assert!((integral - 1.0).abs() < 1e-5, "integral {integral}");
+    assert_eq!(d.pdf(Vec2::new(1.2, 0.5)), 0.0);
+    assert_eq!(d.pdf(Vec2::new(0.5, -0.1)), 0.0);
+}
+
+#[test]
+fn distribution2d_round_trips_and_never_lands_on_an_empty_cell() {
+    let d = Distribution2D::new(&GRID, GRID_NU, GRID_NV).unwrap();
+    let mut rng = Rng::new(28);
+    for u in (0..100_000).map(|_| rng.uniform2()).chain([
+        [0.0, 0.0],
+        [ONE_MINUS_EPSILON; 2],
+        [0.5, 0.5],
+        [0.0, ONE_MINUS_EPSILON],
+    ]) {
+        let (p, pdf) = d.sample(u);
+        assert!(pdf > 0.0 && (0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y));
+        let back = d.invert(p);
+        assert!(
+            square_dist(u, back, false) < 1e-5,
+            "u = {u:?} -> {p} -> {back:?}"
+        );
+    }
+    // One lit cell: every sample lands in it, with density nu * nv.
+    let mut one = [0.0; 12];
+    one[7] = 0.25;
+    let d = Distribution2D::new(&one, 4, 3).unwrap();
+    for _ in 0..1000 {
+        let (p, pdf) = d.sample(rng.uniform2());
+        assert_eq!(pdf, 12.0);
+        assert!(
+            (0.75..1.0).contains(&p.x) && (1.0 / 3.0..2.0 / 3.0).contains(&p.y),
+            "{p}"
+        );
+    }
+}
+
+#[test]
+fn distribution2d_refuses_all_zero_weights() {
+    assert!(Distribution2D::new(&[0.0; 6], 3, 2).is_none());
+    assert!(Distribution2D::new(&[0.0, 0.0, 1e-300], 3, 1).is_some());
 }
