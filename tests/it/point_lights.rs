@@ -140,8 +140,9 @@ fn spot_light_cone_edge() {
     let n = scene.camera.width as usize;
     let (mut inside, mut outside, mut ramp) = (0, 0, 0);
     let (c, b) = (40f64.to_radians(), 35f64.to_radians());
-    // Pixels whose whole footprint is on one side of an edge: the centre 0.3 degrees away.
-    let margin = 0.3f64.to_radians();
+    // Pixels whose whole footprint is on one side of an edge (a pixel spans about 0.8
+    // degrees seen from the light): the centre a degree away.
+    let margin = 1.0f64.to_radians();
     for y in 0..n {
         for x in 0..n {
             let ray = scene.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
