@@ -1362,9 +1362,8 @@ fn point_light_power_and_photons() {
 
 /// A spot's power `2π I ∫ falloff sin θ dθ` in closed form against a midpoint quadrature of
 /// Mitsuba's falloff, and its photons' summed flux against it (stratified in `cos θ`, so the
-/// falloff's kinks cost a little). Measured: quadrature 1e-9, photons 2e-5. With the photons
-/// not weighted by the falloff the sum is 26% high; with the power of a cone of full
-/// intensity out to the cutoff, 16% high.
+/// falloff's kinks cost a little). Measured: closed form against quadrature 3.2e-9
+/// relative, photons 1.3e-6 (a point light's photons: 1.3e-13).
 #[test]
 fn spot_light_power_and_photons() {
     let (_d, s) = delta_scene(
