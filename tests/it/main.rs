@@ -17,6 +17,9 @@
 //!   degenerate triangles, a sphere of radius 1e-4 (also seen up close), light power near the
 //!   f32 limit): every image finite, closed forms, flux and invariances where the scene
 //!   allows a check.
+//! - `point_lights`: point and spot lights against closed forms (`ρ/π I cos θ / r²` over a
+//!   plane in the path tracer and SPPM, a spot's beam, ramp and cutoff), and a point light in
+//!   the glass sphere whose light only photons find.
 //! - `references`: every method's images of the worksheet scene against Mitsuba 3's
 //!   (`tests/references/`, two halves), region by region, with each method's known bias and
 //!   measured noise, and negative controls that must fail.
@@ -53,6 +56,7 @@ mod hard_cases;
 mod kit;
 mod photon_maps;
 mod photons;
+mod point_lights;
 mod references;
 mod shards;
 mod splat;

@@ -90,8 +90,30 @@ pub fn emit_diff(
     scale: f32,
 ) -> (Emitted, RayDiff) {
     let e = sampler.emit(u_light, u_pos, u_dir, photons);
-    let frame = sampler.frame(e.light);
     let n = photons.max(1) as f64;
+    if let Some(l) = sampler.delta(e.light) {
+        // A point or spot light: no positional extent, and a direction cell of solid angle
+        // `1 / (N p_i pdf_dir)` (`4π/N` for one point light; for a spot, the cutoff cone's
+        // solid angle over its photons), `ρ_ω = sqrt(cell / π)` as for the area light.
+        let cone = match &l.spot {
+            None => 4.0 * std::f64::consts::PI,
+            Some(s) => std::f64::consts::TAU * (1.0 - (s.cutoff as f64).cos()),
+        };
+        let cell = cone / (sampler.pmf(e.light) * n);
+        let rho_w = (cell / std::f64::consts::PI).sqrt() as f32 * scale;
+        let d = e.ray.d;
+        let (e1, e2) = perpendicular_pair(d, &Frame::from_z(d));
+        let rd = RayDiff {
+            o: e.ray.o,
+            d,
+            dodu: Vec3::ZERO,
+            dodv: Vec3::ZERO,
+            dddu: rho_w * e1,
+            dddv: rho_w * e2,
+        };
+        return (e, rd);
+    }
+    let frame = sampler.frame(e.light);
     let cell = sampler.area(e.light) as f64 / (sampler.pmf(e.light) * n);
     let rho_x = (cell / std::f64::consts::PI).sqrt() as f32 * scale;
     let cos = e.ray.d.dot(frame.n).max(MIN_EMIT_COS) as f64;

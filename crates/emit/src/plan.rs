@@ -101,6 +101,18 @@ impl Plan {
                 specular.join(", ")
             )
         });
+        // Delta lights (pbrt-v4 §12.1, §12.2): no ray hits them, so eye paths reach them
+        // only by next-event estimation, and a path from one through specular surfaces to a
+        // diffuse one (a caustic) only photons find.
+        for l in &scene.file.lights {
+            let kind = match l {
+                scene::LightDesc::Point { .. } => "point light",
+                scene::LightDesc::Spot { .. } => "spot light",
+            };
+            reasons.push(format!(
+                "{kind}: next-event estimation and photons; never hit by rays; caustics                  through specular surfaces only by photons (the path tracer's caustic layer                  from it is zero)"
+            ));
+        }
         let glossy = names(&|m, _| scene.bsdf(m).is_some_and(|b| b.is_glossy()));
         if !glossy.is_empty() {
             reasons.push(format!(

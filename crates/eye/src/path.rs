@@ -176,7 +176,13 @@ impl<'a> PathTracer<'a> {
                         && sides_agree(wo, ls.wi, ng, wo_l, wi_l)
                         && !geometry.occluded(&hit.point.spawn_ray_to_point(&ls.point))
                     {
-                        let w = power_heuristic(1, ls.pdf, 1, bsdf.pdf(wo_l, wi_l));
+                        // A point or spot light is never hit by BSDF sampling: NEE alone
+                        // reaches it, weight 1 (pbrt-v4 §12.1).
+                        let w = if ls.delta {
+                            1.0
+                        } else {
+                            power_heuristic(1, ls.pdf, 1, bsdf.pdf(wo_l, wi_l))
+                        };
                         let c = beta * f * ls.le * (wi_l.z.abs() * w / ls.pdf);
                         out.add(direct_or_indirect(diffuse_vertices), c);
                     }

@@ -59,6 +59,10 @@ pub struct SceneFile {
     /// Materials by name. They override MTL materials of the same name.
     #[serde(default, rename = "material")]
     pub materials: BTreeMap<String, MaterialDesc>,
+    /// Point and spot lights (`[[light]]`), beside the emissive triangles. Not written back
+    /// when empty: scenes without them keep their hashes.
+    #[serde(default, rename = "light", skip_serializing_if = "Vec::is_empty")]
+    pub lights: Vec<LightDesc>,
     /// Photon-tracing parameters (`[photons]`). Opaque here: the emit stage reads them
     /// (`emit::EmitParams`, with its own unknown-key check), so this crate stays below it.
     #[serde(default)]
@@ -259,6 +263,45 @@ pub struct SphereDesc {
     pub center: [f32; 3],
     pub radius: f32,
     pub material: String,
+}
+
+/// A light that is not a mesh, in Mitsuba 3's units: `intensity` is radiant intensity
+/// (W/sr per channel), angles are degrees.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum LightDesc {
+    /// Mitsuba 3's `point`: intensity `intensity` in every direction (pbrt-v4 §12.1).
+    Point {
+        position: [f32; 3],
+        intensity: [f32; 3],
+    },
+    /// Mitsuba 3's `spot`: full intensity within `beam_width` of the axis towards `look_at`,
+    /// falling linearly in angle to zero at `cutoff_angle` (pbrt-v4 §12.2 uses a smoothstep
+    /// in cos θ instead; we follow Mitsuba).
+    Spot {
+        position: [f32; 3],
+        look_at: [f32; 3],
+        intensity: [f32; 3],
+        #[serde(default = "default_cutoff")]
+        cutoff_angle: f32,
+        /// Default `cutoff_angle * 3/4`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        beam_width: Option<f32>,
+    },
+}
+
+impl LightDesc {
+    /// The `type` key's value, for messages.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            LightDesc::Point { .. } => "point",
+            LightDesc::Spot { .. } => "spot",
+        }
+    }
+}
+
+fn default_cutoff() -> f32 {
+    20.0
 }
 
 /// A material written in the scene file.

@@ -25,10 +25,10 @@ pub use camera::Camera;
 pub use envmap::EnvMap;
 pub use error::SceneError;
 pub use file::{
-    CameraDesc, EmissionSource, MaterialDesc, MeshDesc, Method, NormalMode, RenderSettings,
-    SamplerKind, SceneFile, SphereDesc,
+    CameraDesc, EmissionSource, LightDesc, MaterialDesc, MeshDesc, Method, NormalMode,
+    RenderSettings, SamplerKind, SceneFile, SphereDesc,
 };
-pub use lights::{Emitted, LightPoint, LightSample, LightTable};
+pub use lights::{DeltaLight, Emitted, LightPoint, LightSample, LightTable, Spot};
 pub use load::{AreaLight, Scene, fnv1a64};
 pub use material::{ALPHA_RANGE, Material};
 pub use texture::{Texture, srgb_to_linear};

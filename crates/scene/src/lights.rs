@@ -5,11 +5,16 @@
 //! about the emitting normal, Jensen 2001 §5.1). One table means one weighting of lights for
 //! the eye pass and the photon pass. Random numbers come in as arguments (pbrt-v4's habit:
 //! samplers never own a generator).
+//!
+//! Point and spot lights ([`DeltaLight`]) follow the triangles in the table's numbering.
+//! They are delta lights (pbrt-v4 §12.1, §12.2): no ray ever hits one, so next-event
+//! estimation alone reaches them (no MIS weight: [`LightSample::delta`]) and paths from them
+//! through specular surfaces to a diffuse one are found only by photons.
 
 use crate::AreaLight;
 use geom::{Prim, Ray, SurfacePoint, TriMesh};
 use glam::{DVec3, Vec3};
-use math::warp::{sample_cosine_hemisphere, sample_uniform_triangle};
+use math::warp::{sample_cosine_hemisphere, sample_uniform_sphere, sample_uniform_triangle};
 use math::{Distribution1D, Frame};
 
 /// Marks a triangle that is not a light in the table's lookup.
@@ -40,8 +45,85 @@ pub struct LightSample {
     pub wi: Vec3,
     /// Distance from the receiver to the light point.
     pub dist: f32,
-    /// Solid-angle density at the receiver, the light choice included.
+    /// Solid-angle density at the receiver, the light choice included. For a delta light
+    /// (`delta`) the probability of choosing it, and `le` is then `I falloff / r²`: the
+    /// estimate `f le cos / pdf` keeps its form.
     pub pdf: f32,
+    /// A point or spot light: BSDF sampling can never hit it, so NEE takes weight 1.
+    pub delta: bool,
+}
+
+/// A point or spot light, validated by scene loading (Mitsuba 3's `point` and `spot`).
+#[derive(Clone, Copy, Debug)]
+pub struct DeltaLight {
+    pub position: Vec3,
+    /// Radiant intensity on the axis (W/sr per channel).
+    pub intensity: Vec3,
+    /// `None` for a point light.
+    pub spot: Option<Spot>,
+}
+
+/// A spot light's cone: angles in radians, `0 <= beam <= cutoff <= π/2`.
+#[derive(Clone, Copy, Debug)]
+pub struct Spot {
+    /// `n` is the axis (towards `look_at`).
+    pub frame: Frame,
+    pub cutoff: f32,
+    pub beam: f32,
+}
+
+impl Spot {
+    /// Mitsuba 3's falloff: 1 within `beam` of the axis, linear in angle down to 0 at
+    /// `cutoff`, 0 beyond. `local_z` is cos θ of a unit direction.
+    pub fn falloff(&self, local_z: f32) -> f32 {
+        if local_z <= self.cutoff.cos() {
+            0.0
+        } else if local_z >= self.beam.cos() {
+            1.0
+        } else {
+            ((self.cutoff - local_z.clamp(-1.0, 1.0).acos()) / (self.cutoff - self.beam))
+                .clamp(0.0, 1.0)
+        }
+    }
+
+    /// `∫ falloff dω / 2π = ∫₀^c falloff(θ) sin θ dθ`, in closed form: `1 - cos β` inside the
+    /// beam plus `∫_β^c (c - θ)/(c - β) sin θ dθ = cos β - (sin c - sin β)/(c - β)` across
+    /// the ramp, `1 - (sin c - sin β)/(c - β)` in all (`1 - cos c` when `β = c`).
+    pub fn solid_angle_fraction(&self) -> f64 {
+        let (c, b) = (self.cutoff as f64, self.beam as f64);
+        if c - b < 1e-9 {
+            1.0 - c.cos()
+        } else {
+            1.0 - (c.sin() - b.sin()) / (c - b)
+        }
+    }
+}
+
+impl DeltaLight {
+    /// Emitted power: `4π I` for a point light (pbrt-v4 §12.1), `2π I ∫ falloff sin θ dθ` for
+    /// a spot (§12.2), in f64.
+    pub fn power(&self) -> DVec3 {
+        let frac = match &self.spot {
+            None => 2.0,
+            Some(s) => s.solid_angle_fraction(),
+        };
+        2.0 * std::f64::consts::PI * frac * self.intensity.as_dvec3()
+    }
+
+    /// Intensity towards unit direction `w` (leaving the light).
+    pub fn intensity_towards(&self, w: Vec3) -> Vec3 {
+        match &self.spot {
+            None => self.intensity,
+            Some(s) => self.intensity * s.falloff(s.frame.n.dot(w)),
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+struct DeltaEntry {
+    light: DeltaLight,
+    power: DVec3,
+    pmf: f64,
 }
 
 /// A photon leaving a light.
@@ -76,6 +158,8 @@ struct Entry {
 pub struct LightTable {
     distribution: Distribution1D,
     entries: Vec<Entry>,
+    /// Point and spot lights: light `entries.len() + j` is `deltas[j]`.
+    deltas: Vec<DeltaEntry>,
     /// Light index of each mesh triangle, or `NOT_A_LIGHT`.
     light_of_triangle: Vec<u32>,
     total: DVec3,
@@ -95,10 +179,11 @@ impl LightTable {
             clippy::unreachable
         )
     )]
-    pub fn new(mesh: &TriMesh, lights: &[AreaLight]) -> Option<LightTable> {
+    pub fn new(mesh: &TriMesh, lights: &[AreaLight], deltas: &[DeltaLight]) -> Option<LightTable> {
         let power: Vec<DVec3> = lights
             .iter()
             .map(|l| std::f64::consts::PI * l.area as f64 * l.le.as_dvec3())
+            .chain(deltas.iter().map(DeltaLight::power))
             .collect();
         let weights: Vec<f64> = power.iter().map(|p| p.element_sum()).collect();
         let sum: f64 = weights.iter().sum();
@@ -123,32 +208,60 @@ impl LightTable {
                 pmf: w / sum,
             })
             .collect();
+        let deltas = deltas
+            .iter()
+            .zip(power.iter().skip(lights.len()))
+            .zip(weights.iter().skip(lights.len()))
+            .map(|((&light, &power), w)| DeltaEntry {
+                light,
+                power,
+                pmf: w / sum,
+            })
+            .collect();
         Some(LightTable {
             distribution: Distribution1D::new(&weights),
             entries,
+            deltas,
             light_of_triangle,
             total: power.iter().fold(DVec3::ZERO, |s, p| s + *p),
         })
     }
 
-    /// Number of emissive triangles.
+    /// Number of lights: emissive triangles, then point and spot lights.
     pub fn len(&self) -> usize {
-        self.entries.len()
+        self.entries.len() + self.deltas.len()
     }
 
     /// Always false: [`LightTable::new`] refuses a scene without lights.
     pub fn is_empty(&self) -> bool {
-        self.entries.is_empty()
+        self.len() == 0
+    }
+
+    /// Whether light `i` is a point or spot light (never hit by a ray).
+    pub fn is_delta(&self, i: usize) -> bool {
+        i >= self.entries.len()
+    }
+
+    /// The point or spot light with index `i`, if it is one.
+    pub fn delta(&self, i: usize) -> Option<&DeltaLight> {
+        let j = i.checked_sub(self.entries.len())?;
+        self.deltas.get(j).map(|d| &d.light)
     }
 
     /// Probability of choosing light `i`.
     pub fn pmf(&self, i: usize) -> f64 {
-        self.entries[i].pmf
+        match i.checked_sub(self.entries.len()) {
+            Some(j) => self.deltas[j].pmf,
+            None => self.entries[i].pmf,
+        }
     }
 
-    /// Power `π A Le` of light `i`, f64.
+    /// Power of light `i` (`π A Le` for a triangle, [`DeltaLight::power`]), f64.
     pub fn power(&self, i: usize) -> DVec3 {
-        self.entries[i].power
+        match i.checked_sub(self.entries.len()) {
+            Some(j) => self.deltas[j].power,
+            None => self.entries[i].power,
+        }
     }
 
     /// Total emitted power of all lights, RGB, f64.
@@ -192,9 +305,22 @@ impl LightTable {
         }
     }
 
-    /// `u_light` chooses the light, `u_pos` the point (Heitz's triangle map).
+    /// `u_light` chooses the light, `u_pos` the point (Heitz's triangle map). A point or spot
+    /// light's point is its position, exact (no error bound); `n` is then meaningless.
     pub fn sample_point(&self, u_light: f32, u_pos: [f32; 2]) -> LightPoint {
         let (i, _, _) = self.distribution.sample(u_light);
+        if let Some(j) = i.checked_sub(self.entries.len()) {
+            let d = &self.deltas[j];
+            return LightPoint {
+                light: i,
+                pmf: d.pmf,
+                point: SurfacePoint {
+                    p: d.light.position,
+                    p_err: Vec3::ZERO,
+                    n: Vec3::Z,
+                },
+            };
+        }
         let e = &self.entries[i];
         let v = e.vertices;
         let b = sample_uniform_triangle(u_pos);
@@ -218,7 +344,6 @@ impl LightTable {
             pmf,
             point,
         } = self.sample_point(u_pick, u);
-        let e = &self.entries[i];
         let to = point.p - from;
         let dist2 = to.length_squared();
         if dist2 <= 0.0 || !dist2.is_finite() {
@@ -226,6 +351,24 @@ impl LightTable {
         }
         let dist = dist2.sqrt();
         let wi = to / dist;
+        if let Some(d) = self.delta(i) {
+            // Irradiance-like `I falloff / r²` over the choice probability (pbrt-v4 §12.1's
+            // `SampleLi`): no density in solid angle exists.
+            let le = d.intensity_towards(-wi) / dist2;
+            if le == Vec3::ZERO || !le.is_finite() {
+                return None;
+            }
+            return Some(LightSample {
+                light: i,
+                point,
+                le,
+                wi,
+                dist,
+                pdf: pmf as f32,
+                delta: true,
+            });
+        }
+        let e = &self.entries[i];
         let cos_light = -wi.dot(e.normal);
         if cos_light <= 0.0 || cos_light.is_nan() {
             return None;
@@ -241,6 +384,7 @@ impl LightTable {
             wi,
             dist,
             pdf,
+            delta: false,
         })
     }
 
@@ -265,16 +409,41 @@ impl LightTable {
     /// course framework's `Φ_light · #lights / #shots` is the uniform-choice special case).
     /// With `p_i ∝ |Φ_i|` and one emission colour it equals `Φ_total / N` for every light.
     pub fn flux(&self, i: usize, photons: u64) -> DVec3 {
-        let e = &self.entries[i];
-        e.power / (e.pmf * photons as f64)
+        self.power(i) / (self.pmf(i) * photons as f64)
     }
 
     /// Emit one photon: `u_light` picks the light, `u_pos` the point (Heitz's triangle map),
-    /// `u_dir` the direction (Malley's method about the light's normal).
+    /// `u_dir` the direction (Malley's method about the light's normal). A point light sends
+    /// it uniformly over the sphere, a spot uniformly in its cutoff cone weighted by the
+    /// falloff (Mitsuba 3's `sample_ray`); both carry `I falloff / (pdf_dir p_i N)`, whose
+    /// mean is `Φ_i / (p_i N)` (pbrt-v4 §12.1, §12.2 `SampleLe`).
     pub fn emit(&self, u_light: f32, u_pos: [f32; 2], u_dir: [f32; 2], photons: u64) -> Emitted {
         let LightPoint {
-            light: i, point, ..
+            light: i,
+            point,
+            pmf,
         } = self.sample_point(u_light, u_pos);
+        if let Some(l) = self.delta(i) {
+            let (d, pdf_dir) = match &l.spot {
+                None => (sample_uniform_sphere(u_dir), 0.25 / std::f64::consts::PI),
+                Some(s) => {
+                    let cos_c = s.cutoff.cos();
+                    let z = 1.0 - u_dir[0] * (1.0 - cos_c);
+                    let r = (1.0 - z * z).max(0.0).sqrt();
+                    let phi = std::f32::consts::TAU * u_dir[1];
+                    let local = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+                    let pdf = 1.0 / (std::f64::consts::TAU * (1.0 - cos_c as f64));
+                    (s.frame.to_world(local).normalize(), pdf)
+                }
+            };
+            let flux = l.intensity_towards(d).as_dvec3() / (pdf_dir * pmf * photons as f64);
+            return Emitted {
+                ray: Ray::new(point.p, d),
+                light: i,
+                point,
+                flux,
+            };
+        }
         let d = self.entries[i]
             .frame
             .to_world(sample_cosine_hemisphere(u_dir))

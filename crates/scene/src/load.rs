@@ -14,10 +14,13 @@
 
 use crate::file::{EmissionSource, MaterialDesc, MeshDesc, NormalMode, Scale, SceneFile};
 use crate::material::ALPHA_RANGE;
-use crate::{Camera, LightTable, Material, RenderSettings, SceneError, Texture};
+use crate::{
+    Camera, DeltaLight, LightDesc, LightTable, Material, RenderSettings, SceneError, Spot, Texture,
+};
 use bsdf::Bsdf;
 use geom::{Geometry, Sphere, TriMesh, smooth_vertex_normals};
 use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
+use math::Frame;
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::io::BufReader;
@@ -95,13 +98,17 @@ impl Scene {
         &self.file.render
     }
 
-    /// Total emitted power of all lights, summed in f64.
+    /// Total emitted power of all lights (triangles, then point and spot lights), summed in
+    /// f64.
     pub fn light_power(&self) -> Vec3 {
         let s = self
             .lights
             .iter()
             .fold(DVec3::ZERO, |s, l| s + l.power.as_dvec3());
-        s.as_vec3()
+        let t = &self.light_table;
+        (self.lights.len()..t.len())
+            .fold(s, |s, i| s + t.power(i))
+            .as_vec3()
     }
 
     pub fn light_area(&self) -> f64 {
@@ -164,6 +171,8 @@ impl Scene {
                 meshes: &'a [crate::MeshDesc],
                 spheres: &'a [crate::SphereDesc],
                 materials: &'a std::collections::BTreeMap<String, crate::MaterialDesc>,
+                #[serde(skip_serializing_if = "<[_]>::is_empty")]
+                lights: &'a [crate::LightDesc],
                 camera: Option<&'a crate::CameraDesc>,
                 render: Option<&'a RenderSettings>,
             }
@@ -183,6 +192,7 @@ impl Scene {
                 meshes: &meshes,
                 spheres: &f.spheres,
                 materials: &f.materials,
+                lights: &f.lights,
                 camera: camera.then_some(&f.camera),
                 render: render.then_some(&f.render),
             })
@@ -568,13 +578,16 @@ impl<'a> Builder<'a> {
                 total.to_array()
             )));
         }
-        if lights.is_empty() {
+        let deltas = self.delta_lights(&file.lights)?;
+        if lights.is_empty() && deltas.is_empty() {
             let hint = if file.meshes.iter().any(|m| m.emission == EmissionSource::Ke) {
                 " (hint: the course's MTL files keep emission in Ka: set emission = \"ka\" on the mesh)"
             } else {
                 ""
             };
-            return Err(self.err(format!("the scene has no light: no triangle emits{hint}")));
+            return Err(self.err(format!(
+                "the scene has no light: no triangle emits and no [[light]] is given{hint}"
+            )));
         }
         for s in &self.spheres {
             if self.of_material(&self.emission, s.material)?.max_element() > 0.0 {
@@ -582,7 +595,7 @@ impl<'a> Builder<'a> {
             }
         }
 
-        let Some(light_table) = LightTable::new(&self.mesh, &lights) else {
+        let Some(light_table) = LightTable::new(&self.mesh, &lights, &deltas) else {
             return Err(self.err("the lights' total power is zero: no light can be sampled"));
         };
         // The hashes need the whole scene text: `Scene::from_toml` sets them.
@@ -606,6 +619,77 @@ impl<'a> Builder<'a> {
             image_hash: 0,
             view_hash: 0,
         })
+    }
+
+    /// The scene file's point and spot lights, checked one by one (Mitsuba 3's `point` and
+    /// `spot`; angles in degrees there, radians here).
+    fn delta_lights(&self, descs: &[LightDesc]) -> Result<Vec<DeltaLight>, SceneError> {
+        let mut out = Vec::with_capacity(descs.len());
+        for (i, desc) in descs.iter().enumerate() {
+            let bad = |what: &str| self.err(format!("light {i} ({}): {what}", desc.kind()));
+            let (position, intensity) = match desc {
+                LightDesc::Point {
+                    position,
+                    intensity,
+                }
+                | LightDesc::Spot {
+                    position,
+                    intensity,
+                    ..
+                } => (Vec3::from(*position), Vec3::from(*intensity)),
+            };
+            if !position.is_finite() {
+                return Err(bad("position must be finite"));
+            }
+            if !intensity.is_finite() || intensity.min_element() < 0.0 {
+                return Err(bad("intensity must be finite and >= 0"));
+            }
+            if intensity.max_element() <= 0.0 {
+                return Err(bad(
+                    "intensity must not be zero: the light would emit nothing",
+                ));
+            }
+            let spot = match *desc {
+                LightDesc::Point { .. } => None,
+                LightDesc::Spot {
+                    look_at,
+                    cutoff_angle,
+                    beam_width,
+                    ..
+                } => {
+                    let axis = (Vec3::from(look_at) - position).normalize_or_zero();
+                    if !Vec3::from(look_at).is_finite() || axis == Vec3::ZERO {
+                        return Err(bad("look_at must be finite and differ from position"));
+                    }
+                    if !(cutoff_angle > 0.0 && cutoff_angle <= 90.0) {
+                        return Err(bad(&format!(
+                            "cutoff_angle = {cutoff_angle} must be in (0, 90] degrees"
+                        )));
+                    }
+                    let beam = beam_width.unwrap_or(cutoff_angle * 0.75);
+                    if !(beam >= 0.0 && beam <= cutoff_angle) {
+                        return Err(bad(&format!(
+                            "beam_width = {beam} must be in [0, cutoff_angle = {cutoff_angle}] degrees"
+                        )));
+                    }
+                    Some(Spot {
+                        frame: Frame::from_z(axis),
+                        cutoff: cutoff_angle.to_radians(),
+                        beam: beam.to_radians(),
+                    })
+                }
+            };
+            let light = DeltaLight {
+                position,
+                intensity,
+                spot,
+            };
+            if !light.power().as_vec3().is_finite() {
+                return Err(bad("power overflows f32: intensity is absurd"));
+            }
+            out.push(light);
+        }
+        Ok(out)
     }
 
     fn validate_materials(&self) -> Result<(), SceneError> {
