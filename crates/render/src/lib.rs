@@ -179,9 +179,19 @@ pub fn describe(s: &Scene) -> String {
     let _ = writeln!(o, "scene      {} ({})", s.path.display(), s.file.name);
     let _ = writeln!(o, "triangles  {}", m.len());
     let _ = writeln!(o, "spheres    {}", s.geometry.spheres().len());
+    let t = &s.light_table;
+    let deltas: Vec<_> = (s.lights.len()..t.len())
+        .filter_map(|i| t.delta(i))
+        .collect();
+    let spots = deltas.iter().filter(|d| d.spot.is_some()).count();
+    let points = if deltas.is_empty() {
+        String::new()
+    } else {
+        format!(", {} point and {spots} spot lights", deltas.len() - spots)
+    };
     let _ = writeln!(
         o,
-        "lights     {} emissive triangles, area {:.6}, power {:?}",
+        "lights     {} emissive triangles, area {:.6}{points}, power {:?}",
         s.lights.len(),
         s.light_area(),
         s.light_power().to_array()

@@ -217,3 +217,27 @@ fn boundary_correction_removes_the_darkening_at_an_edge_and_a_corner() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `info` counts the point and spot lights beside the emissive triangles, and its power is
+/// theirs too: 4π I for the point light added to the worksheet scene's triangles.
+#[test]
+fn describe_counts_point_and_spot_lights() {
+    let plain = crate::describe(&cornell());
+    assert!(
+        plain.contains("lights     2 emissive triangles, area"),
+        "{plain}"
+    );
+    assert!(!plain.contains("point"), "{plain}");
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-spheres/analytic.toml");
+    let text = std::fs::read_to_string(&path).unwrap()
+        + "\n[[light]]\ntype = \"point\"\nposition = [-7, 10, -7]\nintensity = [1, 1, 1]\n";
+    let s = scene::Scene::from_toml(&path, &text).unwrap();
+    let d = crate::describe(&s);
+    assert!(
+        d.contains("2 emissive triangles") && d.contains("1 point and 0 spot lights"),
+        "{d}"
+    );
+    let extra = s.light_power().x - cornell().light_power().x;
+    assert!((extra - 4.0 * std::f32::consts::PI).abs() < 1e-3, "{extra}");
+}
