@@ -693,6 +693,13 @@ impl<'a> Builder<'a> {
     }
 
     fn validate_materials(&self) -> Result<(), SceneError> {
+        let glass_ok = |ior: f32, transmittance: Vec3, absorption: Vec3| {
+            ior.is_finite()
+                && ior > 0.0
+                && ior < 10.0
+                && in_unit(transmittance)
+                && non_negative(absorption)
+        };
         for (name, m) in self.names.iter().zip(&self.materials) {
             // Glass's own keys first, each named alone.
             if let Material::Dielectric {
@@ -729,13 +736,7 @@ impl<'a> Builder<'a> {
                     ior,
                     transmittance,
                     absorption,
-                } => {
-                    ior.is_finite()
-                        && *ior > 0.0
-                        && *ior < 10.0
-                        && in_unit(*transmittance)
-                        && non_negative(*absorption)
-                }
+                } => glass_ok(*ior, *transmittance, *absorption),
                 Material::Glossy {
                     albedo,
                     specular,
@@ -766,14 +767,7 @@ impl<'a> Builder<'a> {
                     alpha,
                     transmittance,
                     absorption,
-                } => {
-                    ior.is_finite()
-                        && *ior > 0.0
-                        && *ior < 10.0
-                        && ALPHA_RANGE.contains(alpha)
-                        && in_unit(*transmittance)
-                        && non_negative(*absorption)
-                }
+                } => glass_ok(*ior, *transmittance, *absorption) && ALPHA_RANGE.contains(alpha),
             };
             if !ok {
                 return Err(self.err(format!(
