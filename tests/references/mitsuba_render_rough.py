@@ -8,14 +8,33 @@ albedo textures:
   material, Kd 1 1 1           sRGB-decoded); the OBJ's `vt` become the mesh's texture
                                coordinates as Mitsuba's own OBJ reader makes them, (u, 1 - v)
 
+It also takes `--lights FILE.json`: a JSON list of the scene file's `[[light]]` tables (as
+make.sh writes them, `filename` made absolute), added to the scene as Mitsuba 3 emitters:
+
+  point        -> point (position, intensity)
+  spot         -> spot (to_world = look_at(position, look_at, up), intensity, cutoff_angle,
+                  beam_width given explicitly, default cutoff_angle * 3/4); Mitsuba's spot
+                  shines along its local +z, which look_at maps to look_at - position; up is
+                  [0, 1, 0], or [1, 0, 0] when the axis is within 1 degree of vertical (the
+                  spot is round: up only fixes the unused roll)
+  directional  -> directional (direction: the way the light travels, irradiance)
+  environment  -> envmap (filename, scale, to_world = Rz(z) Ry(y) Rx(x) of `rotate` in
+                  degrees, x applied first); or, with `radiance`, constant (radiance)
+
 Everything else is the peers' script: run as `python mitsuba_render_rough.py PEERS ARGS...`
-with PEERS the peers' directory and ARGS mitsuba_render.py's own."""
+with PEERS the peers' directory and ARGS mitsuba_render.py's own (plus `--lights`)."""
+import json
 import os
 import sys
 
 import numpy as np
 
 peers = sys.argv.pop(1)
+lights_json = None
+if "--lights" in sys.argv:
+    i = sys.argv.index("--lights")
+    lights_json = sys.argv[i + 1]
+    del sys.argv[i:i + 2]
 sys.path.insert(0, peers)
 import mitsuba_render  # noqa: E402
 import objmtl  # noqa: E402
@@ -144,12 +163,57 @@ class WithTexcoords:
             self.pending[id(mesh)] = uv
         return mesh
 
+    def load_dict(self, d, *a, **k):
+        if lights_json and isinstance(d, dict) and d.get("type") == "scene":
+            d = dict(d)
+            with open(lights_json) as f:
+                for i, light in enumerate(json.load(f)):
+                    d[f"light_{i:03d}"] = emitter_dict(self.mi, light)
+        return self.mi.load_dict(d, *a, **k)
+
     def traverse(self, obj):
         params = self.mi.traverse(obj)
         uv = self.pending.pop(id(obj), None)
         if uv is not None:
             params["vertex_texcoords"] = np.ascontiguousarray(uv, dtype=np.float32).ravel()
         return params
+
+
+def rotation_xyz(deg):
+    """Rz(z) Ry(y) Rx(x) for `rotate = [x, y, z]` degrees (x applied first), as a 4x4 list."""
+    x, y, z = np.radians(np.asarray(deg, dtype=np.float64))
+    rx = np.array([[1, 0, 0], [0, np.cos(x), -np.sin(x)], [0, np.sin(x), np.cos(x)]])
+    ry = np.array([[np.cos(y), 0, np.sin(y)], [0, 1, 0], [-np.sin(y), 0, np.cos(y)]])
+    rz = np.array([[np.cos(z), -np.sin(z), 0], [np.sin(z), np.cos(z), 0], [0, 0, 1]])
+    m = np.eye(4)
+    m[:3, :3] = rz @ ry @ rx
+    return m.tolist()
+
+
+def emitter_dict(mi, light):
+    """One scene-file [[light]] table -> a Mitsuba 3 emitter dict (module docstring)."""
+    rgb = mitsuba_render.rgb
+    kind = light["type"]
+    if kind == "point":
+        return {"type": "point", "position": [float(v) for v in light["position"]],
+                "intensity": rgb(light["intensity"])}
+    if kind == "spot":
+        pos, at = (np.asarray(light[k], dtype=np.float64) for k in ("position", "look_at"))
+        axis = (at - pos) / np.linalg.norm(at - pos)
+        up = [0.0, 1.0, 0.0] if abs(axis[1]) < np.cos(np.radians(1.0)) else [1.0, 0.0, 0.0]
+        cutoff = float(light.get("cutoff_angle", 20.0))
+        return {"type": "spot", "intensity": rgb(light["intensity"]), "cutoff_angle": cutoff,
+                "beam_width": float(light.get("beam_width", cutoff * 0.75)),
+                "to_world": mi.ScalarTransform4f().look_at(origin=pos.tolist(), target=at.tolist(), up=up)}
+    if kind == "directional":
+        return {"type": "directional", "direction": [float(v) for v in light["direction"]],
+                "irradiance": rgb(light["irradiance"])}
+    if kind == "environment":
+        if "radiance" in light:
+            return {"type": "constant", "radiance": rgb(light["radiance"])}
+        return {"type": "envmap", "filename": light["filename"], "scale": float(light.get("scale", 1.0)),
+                "to_world": mi.ScalarTransform4f(rotation_xyz(light.get("rotate", [0, 0, 0])))}
+    sys.exit(f"light type {kind}: not mapped")
 
 
 build_scene = mitsuba_render.build_scene
