@@ -11,8 +11,9 @@
 # VARIANT     Mitsuba variant, default llvm_ad_rgb (needs libLLVM >= 16); scalar_rgb is slower
 #             and draws different random numbers, so its images differ within noise
 # NAME        cornell-spheres-analytic, cornell-spheres-closeup, cornell-glossy, cornell-rough,
-#             cornell-textured, cornell-coloured-glass, furnace, plane-light, corner (default:
-#             all)
+#             cornell-textured, cornell-coloured-glass, furnace, plane-light, corner,
+#             point-caustic, cornell-spot, environment (default: all)
+# SPP_POINT, SPP_SPOT, SPP_ENV  spp per half of the last three (default 24576, 8192, 24576)
 # `stats` prints the noise figures of the halves present (the tables of README.md).
 #
 # The scenes are read from scenes/*.toml of this repository (camera, and checks that the
@@ -65,10 +66,13 @@ if kind in ("obj", "obj-spheres"):  # one OBJ, untransformed, MTL materials with
             elif m.get("type") == "rough_conductor" and "eta" not in m and "k" not in m:
                 r = m.get("reflectance", [1, 1, 1])
                 mtl.append(f"newmtl {name}\nKs {r[0]} {r[1]} {r[2]}\nNs {m['alpha']}\nillum 13\n")
+            elif m.get("type") == "lambertian" and set(m) <= {"type", "albedo"}:
+                r = m["albedo"]
+                mtl.append(f"newmtl {name}\nKd {r[0]} {r[1]} {r[2]}\nillum 1\n")
             elif m.get("type") == "rough_dielectric":
                 mtl.append(f"newmtl {name}\nNi {m['ior']}\nNs {m['alpha']}\nillum 14\n")
             else:
-                need(False, f"material {name}: only metal, dielectric, rough_conductor (no eta, k) and rough_dielectric spheres")
+                need(False, f"material {name}: only metal, dielectric, rough_conductor (no eta, k), rough_dielectric and lambertian (no texture, no emission) spheres")
         for i, sp in enumerate(spheres):
             need(sp["material"] in mats, "sphere " + sp["material"] + ": a [material] of the scene file")
             doc["spheres"].append({"name": f"sphere_{i}", "material": sp["material"],
@@ -109,6 +113,31 @@ else:  # worksheet: CornellBox.obj scaled 0.025, turned 180 degrees about y, two
         doc["mtllib"] = os.path.basename(out)[:-5] + "-spheres.mtl"
         with open(out[:-5] + "-spheres.json", "w") as f:
             json.dump(doc, f)
+# [[light]]: the scene file's tables as a JSON list beside OUT (OUT-lights.json), each checked
+# against the keys mitsuba_render_rough.py maps (--lights), an environment's filename made
+# absolute (relative to the scene file).
+keys = {"point": ({"position", "intensity"}, set()),
+        "spot": ({"position", "look_at", "intensity"}, {"cutoff_angle", "beam_width"}),
+        "directional": ({"direction", "irradiance"}, set()),
+        "environment": (set(), {"filename", "scale", "radiance", "rotate"})}
+lights = []
+for i, l in enumerate(s.get("light", [])):
+    l = dict(l)
+    kind = l.pop("type", None)
+    need(kind in keys, f"light {i}: type point, spot, directional or environment")
+    req, opt = keys[kind]
+    need(req <= set(l) <= req | opt, f"light {i} ({kind}): keys {sorted(req)} and optionally {sorted(opt)}")
+    if kind == "environment":
+        need(("filename" in l) != ("radiance" in l), f"light {i}: filename or radiance, one of them")
+        need("radiance" not in l or set(l) == {"radiance"}, f"light {i}: radiance alone (a constant has no scale or rotate)")
+        if "filename" in l:
+            l["filename"] = os.path.join(os.path.dirname(os.path.abspath(src)), l["filename"])
+            need(os.path.exists(l["filename"]), f"light {i}: {l['filename']} exists")
+    l["type"] = kind
+    lights.append(l)
+if lights:
+    with open(out[:-5] + "-lights.json", "w") as f:
+        json.dump(lights, f)
 c = s["camera"]
 cam = {"type": "perspective", "position": c["eye"], "look_at": c["look_at"],
        "up": c.get("up", [0.0, 1.0, 0.0]), "vfov_deg": c["vfov"], "width": int(w), "height": int(h),
@@ -119,17 +148,21 @@ EOF
 }
 
 # Two halves of one scene. render NAME KIND SCENE.toml W H SPP SPP_PER_PASS OBJ [ARGS...]
+# INTEGRATOR=ptracer before the call picks Mitsuba's particle (light) tracer (default path);
+# the scene file's [[light]] tables go to the wrapper as --lights (camera() writes them).
 render() {
   local name=$1 kind=$2 toml=$3 w=$4 h=$5 spp=$6 pp=$7 obj=$8
   shift 8
   camera "$kind" "$toml" "$w" "$h" "$TMP/$name-${w}x$h.json"
-  local half seed
+  local half seed lights=() integrator=${INTEGRATOR:-path}
+  [ ! -e "$TMP/$name-${w}x$h-lights.json" ] || lights=(--lights "$TMP/$name-${w}x$h-lights.json")
   for half in a b; do
     if [ $half = a ]; then seed=$SEED_A; else seed=$SEED_B; fi
-    echo "== $name ${w}x$h half $half: seed $seed, $spp spp"
-    "$PY" "$HERE/mitsuba_render_rough.py" "$PEERS" "$obj" "$@" --camera "$TMP/$name-${w}x$h.json" \
+    echo "== $name ${w}x$h half $half: seed $seed, $spp spp, $integrator"
+    "$PY" "$HERE/mitsuba_render_rough.py" "$PEERS" "$obj" "$@" ${lights[@]+"${lights[@]}"} \
+      --camera "$TMP/$name-${w}x$h.json" \
       --width "$w" --height "$h" --spp "$spp" --spp-per-pass "$pp" --seed "$seed" \
-      --integrator path --max-depth -1 --rr-depth 5 --sampler independent --rfilter box \
+      --integrator "$integrator" --max-depth -1 --rr-depth 5 --sampler independent --rfilter box \
       --variant "$VARIANT" -o "$HERE/$name-${w}x$h-$half.exr"
   done
 }
@@ -170,10 +203,14 @@ for fa in sorted(glob.glob(os.path.join(sys.argv[2], "*-a.exr"))):
 EOF
 }
 
+# spp per half of the light-lit scenes (overridable for quick looks)
+SPP_POINT=${SPP_POINT:-24576}
+SPP_SPOT=${SPP_SPOT:-8192}
+SPP_ENV=${SPP_ENV:-24576}
 P=$PEERS/worksheet
 S=$REPO/scenes
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough cornell-textured cornell-coloured-glass furnace plane-light corner)
+[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough cornell-textured cornell-coloured-glass furnace plane-light corner point-caustic cornell-spot environment)
 for n in "${names[@]}"; do
   case $n in
     cornell-spheres-analytic)
@@ -204,6 +241,16 @@ for n in "${names[@]}"; do
       render $n obj "$S/plane-light/plane-light.toml" 64 64 16384 1024 "$S/plane-light/plane.obj" ;;
     corner)
       render $n obj "$S/corner/corner.toml" 64 64 16384 1024 "$S/corner/corner.obj" ;;
+    point-caustic)
+      # Lit only by a point light: the light tracer (ptracer) finds its caustic, path cannot.
+      INTEGRATOR=ptracer render $n obj-spheres "$S/point-caustic/glass-sphere.toml" 128 128 $SPP_POINT 256 \
+        "$S/point-caustic/floor.obj" --spheres "$TMP/$n-128x128-spheres.json" ;;
+    cornell-spot)
+      INTEGRATOR=ptracer render $n obj-spheres "$S/cornell-spot/spot.toml" 128 128 $SPP_SPOT 256 \
+        "$S/cornell-spot/box.obj" --spheres "$TMP/$n-128x128-spheres.json" ;;
+    environment)
+      render $n obj-spheres "$S/environment/env-only.toml" 128 128 $SPP_ENV 1024 \
+        "$S/environment/floor.obj" --spheres "$TMP/$n-128x128-spheres.json" ;;
     stats) stats ;;
     *) echo "unknown NAME $n" >&2; exit 2 ;;
   esac
