@@ -120,34 +120,56 @@ impl<'a> PathTracer<'a> {
         // hit then competes with NEE and is MIS-weighted. `None` after a specular bounce.
         let mut from_diffuse: Option<(Vec3, f32)> = None;
         let mut bounces = 0u32;
-        while let Some(hit) = geometry.intersect(&ray) {
-            // Beer-Lambert along the segment just traced, when it ran inside absorbing glass.
-            beta *= self.scene.transmittance_to(&hit, &ray);
-            // Emission found by the path itself.
-            if let Some(light) = lights.light_of(hit.prim) {
-                let le = lights.le(light, ray.d);
-                if le != Vec3::ZERO {
-                    if diffuse_vertices == 0 {
-                        out.add(Class::Emitted, beta * le);
-                    } else if let Some((p, pdf_bsdf)) = from_diffuse {
-                        let pdf_light = lights.pdf(light, p, hit.point.p);
-                        let w = power_heuristic(1, pdf_bsdf, 1, pdf_light);
-                        out.add(direct_or_indirect(diffuse_vertices), beta * le * w);
-                    } else if !last_lobe_diffuse {
-                        // Specular chain from a glossy lobe to the light (L S+ G ...): no
-                        // caustic photon ends on a glossy lobe, so the path tracer keeps it.
-                        out.add(direct_or_indirect(diffuse_vertices), beta * le);
-                    } else if diffuse_lobes > 1 {
-                        // Specular chain from a diffuse vertex to the light: NEE's shadow
-                        // rays cannot follow it, so BSDF sampling owns it (weight 1).
-                        if self.opts.caustic_indirect {
-                            out.add(Class::CausticIndirect, beta * le);
+        loop {
+            let hit = geometry.intersect(&ray);
+            // Emission found by the path itself: an emissive triangle hit, or the lights at
+            // infinity seen by a ray that leaves the scene. `mis` is its contribution
+            // MIS-weighted against next-event estimation, read only after a non-delta bounce.
+            let (le, mis) = match &hit {
+                Some(hit) => {
+                    // Beer-Lambert along the segment just traced, inside absorbing glass.
+                    beta *= self.scene.transmittance_to(hit, &ray);
+                    match lights.light_of(hit.prim) {
+                        Some(light) => {
+                            let le = lights.le(light, ray.d);
+                            let mis = |(p, pdf_bsdf): (Vec3, f32)| {
+                                let pdf_light = lights.pdf(light, p, hit.point.p);
+                                beta * le * power_heuristic(1, pdf_bsdf, 1, pdf_light)
+                            };
+                            (le, from_diffuse.map(mis))
                         }
-                    } else if self.opts.caustics {
-                        out.add(Class::Caustic, beta * le);
+                        None => (Vec3::ZERO, None),
                     }
                 }
+                None => {
+                    let d = ray.d.normalize();
+                    let le = lights.escaped(d);
+                    let mis = |(_, pdf_bsdf): (Vec3, f32)| beta * lights.escaped_mis(d, pdf_bsdf);
+                    (le, from_diffuse.filter(|_| le != Vec3::ZERO).map(mis))
+                }
+            };
+            if le != Vec3::ZERO {
+                if diffuse_vertices == 0 {
+                    out.add(Class::Emitted, beta * le);
+                } else if let Some(c) = mis {
+                    out.add(direct_or_indirect(diffuse_vertices), c);
+                } else if !last_lobe_diffuse {
+                    // Specular chain from a glossy lobe to the light (L S+ G ...): no caustic
+                    // photon ends on a glossy lobe, so the path tracer keeps it.
+                    out.add(direct_or_indirect(diffuse_vertices), beta * le);
+                } else if diffuse_lobes > 1 {
+                    // Specular chain from a diffuse vertex to the light: NEE's shadow rays
+                    // cannot follow it, so BSDF sampling owns it (weight 1).
+                    if self.opts.caustic_indirect {
+                        out.add(Class::CausticIndirect, beta * le);
+                    }
+                } else if self.opts.caustics {
+                    out.add(Class::Caustic, beta * le);
+                }
             }
+            let Some(hit) = hit else {
+                break;
+            };
             if bounces >= self.opts.max_depth {
                 break;
             }

@@ -172,6 +172,11 @@ pub(crate) fn first_diffuse(
             continue;
         }
         let Some(hit) = scene.geometry.intersect(&b.ray) else {
+            // Leaving the scene: the lights at infinity it sees, on the same terms as an
+            // emissive triangle's hit below.
+            if count_emission || b.glossy {
+                emitted += b.beta * lights.escaped(b.ray.d.normalize());
+            }
             continue;
         };
         // Beer-Lambert along the segment just traced, when it ran inside absorbing glass.

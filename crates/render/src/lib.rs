@@ -184,11 +184,30 @@ pub fn describe(s: &Scene) -> String {
         .filter_map(|i| t.delta(i))
         .collect();
     let spots = deltas.iter().filter(|d| d.spot.is_some()).count();
-    let points = if deltas.is_empty() {
+    let mut points = if deltas.is_empty() {
         String::new()
     } else {
         format!(", {} point and {spots} spot lights", deltas.len() - spots)
     };
+    let infinite: Vec<_> = (s.lights.len()..t.len())
+        .filter_map(|i| t.infinite(i))
+        .collect();
+    if !infinite.is_empty() {
+        let kind = |l: &&scene::InfiniteLight| match l {
+            scene::InfiniteLight::Directional { .. } => 0,
+            scene::InfiniteLight::Sun { .. } => 1,
+            scene::InfiniteLight::Environment(_) => 2,
+        };
+        let n = |k| infinite.iter().filter(|l| kind(l) == k).count();
+        let _ = write!(
+            points,
+            ", {} directional, {} sun and {} environment lights (scene radius {})",
+            n(0),
+            n(1),
+            n(2),
+            t.scene_radius()
+        );
+    }
     let _ = writeln!(
         o,
         "lights     {} emissive triangles, area {:.6}{points}, power {:?}",

@@ -204,6 +204,11 @@ impl EnvMap {
         }
     }
 
+    /// `∫ L dω` over the sphere, `scale` included, per channel in f64.
+    pub fn radiance_integral(&self) -> glam::DVec3 {
+        glam::DVec3::from_array(self.integral) * self.scale as f64
+    }
+
     /// Power entering a sphere of radius `scene_radius` around the scene:
     /// `Φ = π r² ∫ L(ω) dω` (pbrt-v4 §12.5.2, `ImageInfiniteLight::Phi`): from each
     /// direction, radiance crosses the sphere's projected disk of area `π r²`. The integral is

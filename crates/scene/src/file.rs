@@ -288,6 +288,30 @@ pub enum LightDesc {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         beam_width: Option<f32>,
     },
+    /// Mitsuba 3's `directional`: parallel light travelling along `direction`, `irradiance`
+    /// (W/m² per channel) on a surface facing it (pbrt-v4 §12.4). With `angular_radius`
+    /// (degrees, > 0) it is a sun disc of that radius and uniform radiance instead, which
+    /// rays can hit and which casts soft shadows.
+    Directional {
+        direction: [f32; 3],
+        irradiance: [f32; 3],
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        angular_radius: Option<f32>,
+    },
+    /// Light from infinitely far away: Mitsuba 3's `envmap` (a lat-long EXR or Radiance HDR
+    /// image of radiance, `filename` relative to the scene file, times `scale`) or, with
+    /// `radiance` instead, its `constant`. `rotate` turns it about x, y, z (degrees), as a
+    /// mesh's `rotate` does: Mitsuba's `to_world`.
+    Environment {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        filename: Option<String>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        radiance: Option<[f32; 3]>,
+        #[serde(default = "default_scale")]
+        scale: f32,
+        #[serde(default)]
+        rotate: [f32; 3],
+    },
 }
 
 impl LightDesc {
@@ -296,8 +320,14 @@ impl LightDesc {
         match self {
             LightDesc::Point { .. } => "point",
             LightDesc::Spot { .. } => "spot",
+            LightDesc::Directional { .. } => "directional",
+            LightDesc::Environment { .. } => "environment",
         }
     }
+}
+
+fn default_scale() -> f32 {
+    1.0
 }
 
 fn default_cutoff() -> f32 {

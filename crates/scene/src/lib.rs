@@ -28,7 +28,7 @@ pub use file::{
     CameraDesc, EmissionSource, LightDesc, MaterialDesc, MeshDesc, Method, NormalMode,
     RenderSettings, SamplerKind, SceneFile, SphereDesc,
 };
-pub use lights::{DeltaLight, Emitted, LightPoint, LightSample, LightTable, Spot};
+pub use lights::{DeltaLight, Emitted, InfiniteLight, LightPoint, LightSample, LightTable, Spot};
 pub use load::{AreaLight, Scene, fnv1a64};
 pub use material::{ALPHA_RANGE, Material};
 pub use texture::{Texture, srgb_to_linear};

@@ -10,12 +10,21 @@
 //! They are delta lights (pbrt-v4 §12.1, §12.2): no ray ever hits one, so next-event
 //! estimation alone reaches them (no MIS weight: [`LightSample::delta`]) and paths from them
 //! through specular surfaces to a diffuse one are found only by photons.
+//!
+//! Lights at infinity ([`InfiniteLight`]: directional, sun disc, environment map) come last.
+//! Their photons leave a disc of the scene's bounding-sphere radius `R` facing the light, so
+//! their power is `π R²` times the irradiance they bring (pbrt-v4 §12.4, §12.5); a shadow ray
+//! towards one ends beyond that sphere. A ray that leaves the scene sees the sun discs and
+//! environment maps ([`LightTable::escaped`]).
 
-use crate::AreaLight;
-use geom::{Prim, Ray, SurfacePoint, TriMesh};
+use crate::{AreaLight, EnvMap};
+use geom::{Bounds3, Prim, Ray, SurfacePoint, TriMesh};
 use glam::{DVec3, Vec3};
-use math::warp::{sample_cosine_hemisphere, sample_uniform_sphere, sample_uniform_triangle};
-use math::{Distribution1D, Frame};
+use math::warp::{
+    sample_cosine_hemisphere, sample_uniform_disk_concentric, sample_uniform_sphere,
+    sample_uniform_triangle,
+};
+use math::{Distribution1D, Frame, power_heuristic};
 
 /// Marks a triangle that is not a light in the table's lookup.
 const NOT_A_LIGHT: u32 = u32::MAX;
@@ -119,6 +128,136 @@ impl DeltaLight {
     }
 }
 
+/// A light at infinity, validated by scene loading.
+#[derive(Clone, Debug)]
+pub enum InfiniteLight {
+    /// Mitsuba 3's `directional` (pbrt-v4 §12.4): `irradiance` on a surface facing the unit
+    /// direction `to_light` (against the light's travel). A delta light.
+    Directional { to_light: Vec3, irradiance: Vec3 },
+    /// A disc of uniform `radiance` and angular radius `acos(cos_max)` about `frame.n`
+    /// (towards the light), sampled uniformly in its cone.
+    Sun {
+        frame: Frame,
+        cos_max: f32,
+        radiance: Vec3,
+    },
+    /// Mitsuba 3's `envmap` or `constant` ([`EnvMap`]).
+    Environment(Box<EnvMap>),
+}
+
+impl InfiniteLight {
+    /// A sun disc bringing `irradiance` to a surface facing it: the disc's cone of half-angle
+    /// `α` gives `E = π L sin²α`, so `L = E / (π sin²α)`.
+    pub fn sun(to_light: Vec3, irradiance: Vec3, angular_radius: f32) -> InfiniteLight {
+        let cos_max = angular_radius.cos();
+        let sin2 = angular_radius.sin().powi(2);
+        InfiniteLight::Sun {
+            frame: Frame::from_z(to_light),
+            cos_max,
+            radiance: irradiance / (std::f32::consts::PI * sin2),
+        }
+    }
+
+    pub fn is_delta(&self) -> bool {
+        matches!(self, InfiniteLight::Directional { .. })
+    }
+
+    /// Radiance carried along a ray escaping in unit direction `d` (zero for a directional
+    /// light: no ray hits it).
+    #[inline]
+    pub fn le(&self, d: Vec3) -> Vec3 {
+        match self {
+            InfiniteLight::Directional { .. } => Vec3::ZERO,
+            InfiniteLight::Sun {
+                frame,
+                cos_max,
+                radiance,
+            } => {
+                if d.dot(frame.n) >= *cos_max {
+                    *radiance
+                } else {
+                    Vec3::ZERO
+                }
+            }
+            InfiniteLight::Environment(env) => env.eval(d),
+        }
+    }
+
+    /// A unit direction towards the light, the radiance along it, and its solid-angle
+    /// density (1 for a directional light, whose "radiance" is then its irradiance).
+    fn sample(&self, u: [f32; 2]) -> (Vec3, Vec3, f32) {
+        match self {
+            InfiniteLight::Directional {
+                to_light,
+                irradiance,
+            } => (*to_light, *irradiance, 1.0),
+            InfiniteLight::Sun {
+                frame,
+                cos_max,
+                radiance,
+            } => {
+                let z = 1.0 - u[0] * (1.0 - cos_max);
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let phi = std::f32::consts::TAU * u[1];
+                let local = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+                (
+                    frame.to_world(local).normalize(),
+                    *radiance,
+                    1.0 / (std::f32::consts::TAU * (1.0 - cos_max)),
+                )
+            }
+            InfiniteLight::Environment(env) => env.sample(u),
+        }
+    }
+
+    /// Solid-angle density of [`InfiniteLight::sample`] at unit direction `d`.
+    #[inline]
+    pub fn pdf(&self, d: Vec3) -> f32 {
+        match self {
+            InfiniteLight::Directional { .. } => 0.0,
+            InfiniteLight::Sun { frame, cos_max, .. } => {
+                if d.dot(frame.n) >= *cos_max {
+                    1.0 / (std::f32::consts::TAU * (1.0 - cos_max))
+                } else {
+                    0.0
+                }
+            }
+            InfiniteLight::Environment(env) => env.pdf(d),
+        }
+    }
+
+    /// Solid angle a photon's direction cell covers per unit of `1 / N` at direction `d`
+    /// (zero for a directional light, whose photons are parallel): `1 / pdf`.
+    pub fn direction_cell(&self, d: Vec3) -> f64 {
+        match self {
+            InfiniteLight::Directional { .. } => 0.0,
+            _ => {
+                let pdf = self.pdf(d) as f64;
+                if pdf > 0.0 { 1.0 / pdf } else { 0.0 }
+            }
+        }
+    }
+
+    /// `∫ L dω` over the sphere (the irradiance for a directional light), f64: its power
+    /// through a disc of radius `R` is `π R²` times this.
+    pub fn integral(&self) -> DVec3 {
+        match self {
+            InfiniteLight::Directional { irradiance, .. } => irradiance.as_dvec3(),
+            InfiniteLight::Sun {
+                cos_max, radiance, ..
+            } => std::f64::consts::TAU * (1.0 - *cos_max as f64) * radiance.as_dvec3(),
+            InfiniteLight::Environment(env) => env.radiance_integral(),
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+struct InfiniteEntry {
+    light: InfiniteLight,
+    power: DVec3,
+    pmf: f64,
+}
+
 #[derive(Clone, Copy, Debug)]
 struct DeltaEntry {
     light: DeltaLight,
@@ -160,6 +299,12 @@ pub struct LightTable {
     entries: Vec<Entry>,
     /// Point and spot lights: light `entries.len() + j` is `deltas[j]`.
     deltas: Vec<DeltaEntry>,
+    /// Lights at infinity, after the point and spot lights.
+    infinite: Vec<InfiniteEntry>,
+    /// The scene's bounding sphere (pbrt-v4's `Bounds3::BoundingSphere`): where photons from
+    /// lights at infinity start and shadow rays towards them end.
+    center: Vec3,
+    radius: f32,
     /// Light index of each mesh triangle, or `NOT_A_LIGHT`.
     light_of_triangle: Vec<u32>,
     total: DVec3,
@@ -179,11 +324,28 @@ impl LightTable {
             clippy::unreachable
         )
     )]
-    pub fn new(mesh: &TriMesh, lights: &[AreaLight], deltas: &[DeltaLight]) -> Option<LightTable> {
+    pub fn new(
+        mesh: &TriMesh,
+        lights: &[AreaLight],
+        deltas: &[DeltaLight],
+        infinite: &[InfiniteLight],
+        bounds: Bounds3,
+    ) -> Option<LightTable> {
+        let (center, radius) = if bounds.is_empty() {
+            (Vec3::ZERO, 0.0)
+        } else {
+            let c = 0.5 * (bounds.min + bounds.max);
+            (c, (bounds.max - c).length())
+        };
+        if !infinite.is_empty() && !(radius.is_finite() && radius > 0.0) {
+            return None;
+        }
+        let disc = std::f64::consts::PI * (radius as f64).powi(2);
         let power: Vec<DVec3> = lights
             .iter()
             .map(|l| std::f64::consts::PI * l.area as f64 * l.le.as_dvec3())
             .chain(deltas.iter().map(DeltaLight::power))
+            .chain(infinite.iter().map(|l| disc * l.integral()))
             .collect();
         let weights: Vec<f64> = power.iter().map(|p| p.element_sum()).collect();
         let sum: f64 = weights.iter().sum();
@@ -208,7 +370,7 @@ impl LightTable {
                 pmf: w / sum,
             })
             .collect();
-        let deltas = deltas
+        let deltas: Vec<DeltaEntry> = deltas
             .iter()
             .zip(power.iter().skip(lights.len()))
             .zip(weights.iter().skip(lights.len()))
@@ -218,18 +380,33 @@ impl LightTable {
                 pmf: w / sum,
             })
             .collect();
+        let skip = lights.len() + deltas.len();
+        let infinite = infinite
+            .iter()
+            .zip(power.iter().skip(skip))
+            .zip(weights.iter().skip(skip))
+            .map(|((light, &power), w)| InfiniteEntry {
+                light: light.clone(),
+                power,
+                pmf: w / sum,
+            })
+            .collect();
         Some(LightTable {
             distribution: Distribution1D::new(&weights),
             entries,
             deltas,
+            infinite,
+            center,
+            radius,
             light_of_triangle,
             total: power.iter().fold(DVec3::ZERO, |s, p| s + *p),
         })
     }
 
-    /// Number of lights: emissive triangles, then point and spot lights.
+    /// Number of lights: emissive triangles, then point and spot lights, then lights at
+    /// infinity.
     pub fn len(&self) -> usize {
-        self.entries.len() + self.deltas.len()
+        self.entries.len() + self.deltas.len() + self.infinite.len()
     }
 
     /// Always false: [`LightTable::new`] refuses a scene without lights.
@@ -237,9 +414,12 @@ impl LightTable {
         self.len() == 0
     }
 
-    /// Whether light `i` is a point or spot light (never hit by a ray).
+    /// Whether light `i` is a point, spot or directional light (never hit by a ray).
     pub fn is_delta(&self, i: usize) -> bool {
-        i >= self.entries.len()
+        match self.infinite_entry(i) {
+            Some(e) => e.light.is_delta(),
+            None => i >= self.entries.len(),
+        }
     }
 
     /// The point or spot light with index `i`, if it is one.
@@ -248,20 +428,72 @@ impl LightTable {
         self.deltas.get(j).map(|d| &d.light)
     }
 
+    fn infinite_entry(&self, i: usize) -> Option<&InfiniteEntry> {
+        let k = i.checked_sub(self.entries.len() + self.deltas.len())?;
+        self.infinite.get(k)
+    }
+
+    /// The light at infinity with index `i`, if it is one.
+    pub fn infinite(&self, i: usize) -> Option<&InfiniteLight> {
+        self.infinite_entry(i).map(|e| &e.light)
+    }
+
+    /// Whether any light sits at infinity (escaped rays may then carry light).
+    pub fn has_infinite(&self) -> bool {
+        !self.infinite.is_empty()
+    }
+
+    /// Radius of the scene's bounding sphere, the disc photons from infinity start on.
+    pub fn scene_radius(&self) -> f32 {
+        self.radius
+    }
+
     /// Probability of choosing light `i`.
     pub fn pmf(&self, i: usize) -> f64 {
+        if let Some(e) = self.infinite_entry(i) {
+            return e.pmf;
+        }
         match i.checked_sub(self.entries.len()) {
             Some(j) => self.deltas[j].pmf,
             None => self.entries[i].pmf,
         }
     }
 
-    /// Power of light `i` (`π A Le` for a triangle, [`DeltaLight::power`]), f64.
+    /// Power of light `i` (`π A Le` for a triangle, [`DeltaLight::power`], `π R²` times
+    /// [`InfiniteLight::integral`]), f64.
     pub fn power(&self, i: usize) -> DVec3 {
+        if let Some(e) = self.infinite_entry(i) {
+            return e.power;
+        }
         match i.checked_sub(self.entries.len()) {
             Some(j) => self.deltas[j].power,
             None => self.entries[i].power,
         }
+    }
+
+    /// Radiance a ray leaving the scene along unit `d` receives from the lights at infinity
+    /// (sun discs and environment maps), unweighted: for camera rays and specular chains,
+    /// which next-event estimation cannot produce.
+    #[inline]
+    pub fn escaped(&self, d: Vec3) -> Vec3 {
+        self.infinite.iter().map(|e| e.light.le(d)).sum()
+    }
+
+    /// [`LightTable::escaped`] after a non-delta bounce whose BSDF density was `pdf_bsdf`:
+    /// each light weighted by the power heuristic against next-event estimation's density
+    /// of that direction (its choice probability times its own density; Veach 1997 §9.2).
+    #[inline]
+    pub fn escaped_mis(&self, d: Vec3, pdf_bsdf: f32) -> Vec3 {
+        self.infinite
+            .iter()
+            .map(|e| {
+                let le = e.light.le(d);
+                if le == Vec3::ZERO {
+                    return Vec3::ZERO;
+                }
+                le * power_heuristic(1, pdf_bsdf, 1, e.pmf as f32 * e.light.pdf(d))
+            })
+            .sum()
     }
 
     /// Total emitted power of all lights, RGB, f64.
@@ -307,7 +539,7 @@ impl LightTable {
 
     /// `u_light` chooses the light, `u_pos` the point (Heitz's triangle map). A point or spot
     /// light's point is its position, exact (no error bound); `n` is then meaningless.
-    pub fn sample_point(&self, u_light: f32, u_pos: [f32; 2]) -> LightPoint {
+    fn sample_point(&self, u_light: f32, u_pos: [f32; 2]) -> LightPoint {
         let (i, _, _) = self.distribution.sample(u_light);
         if let Some(j) = i.checked_sub(self.entries.len()) {
             let d = &self.deltas[j];
@@ -339,6 +571,9 @@ impl LightTable {
     /// `None` when the point cannot send light to `from` (it sees the light's back or lies in
     /// its plane), which NEE counts as a zero contribution.
     pub fn sample(&self, from: Vec3, u_pick: f32, u: [f32; 2]) -> Option<LightSample> {
+        if let Some(e) = self.infinite_entry(self.distribution.sample(u_pick).0) {
+            return self.sample_infinite(e, from, u_pick, u);
+        }
         let LightPoint {
             light: i,
             pmf,
@@ -388,6 +623,41 @@ impl LightTable {
         })
     }
 
+    /// A direction towards a light at infinity, its shadow ray ending past the scene's
+    /// bounding sphere (pbrt-v4 §12.4: `p + wi · 2R`, here from `from`'s own distance).
+    fn sample_infinite(
+        &self,
+        e: &InfiniteEntry,
+        from: Vec3,
+        u_pick: f32,
+        u: [f32; 2],
+    ) -> Option<LightSample> {
+        let (wi, le, pdf_dir) = e.light.sample(u);
+        let delta = e.light.is_delta();
+        let pdf = if delta {
+            e.pmf as f32
+        } else {
+            e.pmf as f32 * pdf_dir
+        };
+        if le == Vec3::ZERO || !(pdf.is_finite() && pdf > 0.0) || !wi.is_finite() {
+            return None;
+        }
+        let dist = 2.0 * (self.radius + (from - self.center).length());
+        Some(LightSample {
+            light: self.distribution.sample(u_pick).0,
+            point: SurfacePoint {
+                p: from + dist * wi,
+                p_err: Vec3::ZERO,
+                n: -wi,
+            },
+            le,
+            wi,
+            dist,
+            pdf,
+            delta,
+        })
+    }
+
     /// Solid-angle density with which [`LightTable::sample`] from `from` produces the point
     /// `to` on light `light` (the MIS weight of a BSDF-sampled hit). Zero from behind.
     pub fn pdf(&self, light: usize, from: Vec3, to: Vec3) -> f32 {
@@ -418,6 +688,10 @@ impl LightTable {
     /// falloff (Mitsuba 3's `sample_ray`); both carry `I falloff / (pdf_dir p_i N)`, whose
     /// mean is `Φ_i / (p_i N)` (pbrt-v4 §12.1, §12.2 `SampleLe`).
     pub fn emit(&self, u_light: f32, u_pos: [f32; 2], u_dir: [f32; 2], photons: u64) -> Emitted {
+        let i = self.distribution.sample(u_light).0;
+        if let Some(e) = self.infinite_entry(i) {
+            return self.emit_infinite(i, e, u_pos, u_dir, photons);
+        }
         let LightPoint {
             light: i,
             point,
@@ -453,6 +727,43 @@ impl LightTable {
             light: i,
             point,
             flux: self.flux(i, photons),
+        }
+    }
+
+    /// A photon from a light at infinity (pbrt-v4 §12.4, §12.5 `SampleLe`): `u_dir` picks
+    /// the direction towards the light, `u_pos` a point uniform on the disc of radius `R`
+    /// facing it, tangent to the bounding sphere; the photon travels away from the light.
+    /// Flux `L π R² / (pdf_dir p_i N)` (`E π R² / (p_i N)` for a directional light), whose
+    /// mean is `Φ_i / (p_i N)`.
+    fn emit_infinite(
+        &self,
+        i: usize,
+        e: &InfiniteEntry,
+        u_pos: [f32; 2],
+        u_dir: [f32; 2],
+        photons: u64,
+    ) -> Emitted {
+        let (to_light, le, pdf_dir) = e.light.sample(u_dir);
+        let frame = Frame::from_z(to_light);
+        let disc = sample_uniform_disk_concentric(u_pos);
+        let r = self.radius;
+        // Just outside the sphere, so the first surface met is the scene's.
+        let o = self.center + r * (disc.x * frame.s + disc.y * frame.t) + 1.0001 * r * to_light;
+        let area = std::f64::consts::PI * (r as f64).powi(2);
+        let flux = if pdf_dir > 0.0 && pdf_dir.is_finite() {
+            le.as_dvec3() * area / (pdf_dir as f64 * e.pmf * photons as f64)
+        } else {
+            DVec3::ZERO
+        };
+        Emitted {
+            ray: Ray::new(o, -to_light),
+            light: i,
+            point: SurfacePoint {
+                p: o,
+                p_err: Vec3::ZERO,
+                n: -to_light,
+            },
+            flux,
         }
     }
 }

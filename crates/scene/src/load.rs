@@ -15,11 +15,12 @@
 use crate::file::{EmissionSource, MaterialDesc, MeshDesc, NormalMode, Scale, SceneFile};
 use crate::material::ALPHA_RANGE;
 use crate::{
-    Camera, DeltaLight, LightDesc, LightTable, Material, RenderSettings, SceneError, Spot, Texture,
+    Camera, DeltaLight, EnvMap, InfiniteLight, LightDesc, LightTable, Material, RenderSettings,
+    SceneError, Spot, Texture,
 };
 use bsdf::Bsdf;
 use geom::{Geometry, Sphere, TriMesh, smooth_vertex_normals};
-use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
+use glam::{DMat3, DMat4, DVec3, Mat3, Vec2, Vec3};
 use math::Frame;
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -579,7 +580,8 @@ impl<'a> Builder<'a> {
             )));
         }
         let deltas = self.delta_lights(&file.lights)?;
-        if lights.is_empty() && deltas.is_empty() {
+        let infinite = self.infinite_lights(&file.lights)?;
+        if lights.is_empty() && deltas.is_empty() && infinite.is_empty() {
             let hint = if file.meshes.iter().any(|m| m.emission == EmissionSource::Ke) {
                 " (hint: the course's MTL files keep emission in Ka: set emission = \"ka\" on the mesh)"
             } else {
@@ -595,9 +597,23 @@ impl<'a> Builder<'a> {
             }
         }
 
-        let Some(light_table) = LightTable::new(&self.mesh, &lights, &deltas) else {
+        let bounds = self.spheres.iter().fold(self.mesh.bounds(), |b, s| {
+            b.union_point(s.center - Vec3::splat(s.radius))
+                .union_point(s.center + Vec3::splat(s.radius))
+        });
+        if !infinite.is_empty() && (bounds.is_empty() || !(bounds.max - bounds.min).is_finite()) {
+            return Err(self
+                .err("a light at infinity needs a scene of finite, non-empty extent to shine on"));
+        }
+        let Some(light_table) = LightTable::new(&self.mesh, &lights, &deltas, &infinite, bounds)
+        else {
             return Err(self.err("the lights' total power is zero: no light can be sampled"));
         };
+        if !light_table.total_power().as_vec3().is_finite() {
+            return Err(self.err(
+                "the lights' total power overflows f32: a light's value is absurd for the scene's size",
+            ));
+        }
         // The hashes need the whole scene text: `Scene::from_toml` sets them.
         Ok(Scene {
             path: self.scene_path.to_path_buf(),
@@ -637,6 +653,7 @@ impl<'a> Builder<'a> {
                     intensity,
                     ..
                 } => (Vec3::from(*position), Vec3::from(*intensity)),
+                LightDesc::Directional { .. } | LightDesc::Environment { .. } => continue,
             };
             if !position.is_finite() {
                 return Err(bad("position must be finite"));
@@ -650,7 +667,9 @@ impl<'a> Builder<'a> {
                 ));
             }
             let spot = match *desc {
-                LightDesc::Point { .. } => None,
+                LightDesc::Point { .. }
+                | LightDesc::Directional { .. }
+                | LightDesc::Environment { .. } => None,
                 LightDesc::Spot {
                     look_at,
                     cutoff_angle,
@@ -688,6 +707,107 @@ impl<'a> Builder<'a> {
                 return Err(bad("power overflows f32: intensity is absurd"));
             }
             out.push(light);
+        }
+        Ok(out)
+    }
+
+    /// The scene file's directional lights and environment maps, checked one by one, numbered
+    /// as in the file like the point and spot lights. An environment image is read (and
+    /// hashed) here, relative to the scene file.
+    fn infinite_lights(&mut self, descs: &[LightDesc]) -> Result<Vec<InfiniteLight>, SceneError> {
+        let mut out = Vec::new();
+        for (i, desc) in descs.iter().enumerate() {
+            let bad = |b: &Self, what: &str| b.err(format!("light {i} ({}): {what}", desc.kind()));
+            match desc {
+                LightDesc::Point { .. } | LightDesc::Spot { .. } => {}
+                LightDesc::Directional {
+                    direction,
+                    irradiance,
+                    angular_radius,
+                } => {
+                    let to_light = -Vec3::from(*direction).normalize_or_zero();
+                    if !Vec3::from(*direction).is_finite() || to_light == Vec3::ZERO {
+                        return Err(bad(self, "direction must be finite and not zero"));
+                    }
+                    let e = Vec3::from(*irradiance);
+                    if !e.is_finite() || e.min_element() < 0.0 {
+                        return Err(bad(self, "irradiance must be finite and >= 0"));
+                    }
+                    if e.max_element() <= 0.0 {
+                        return Err(bad(
+                            self,
+                            "irradiance must not be zero: the light would emit nothing",
+                        ));
+                    }
+                    out.push(match *angular_radius {
+                        None => InfiniteLight::Directional {
+                            to_light,
+                            irradiance: e,
+                        },
+                        Some(a) if a > 0.0 && a <= 90.0 => {
+                            InfiniteLight::sun(to_light, e, a.to_radians())
+                        }
+                        Some(a) => {
+                            return Err(bad(
+                                self,
+                                &format!("angular_radius = {a} must be in (0, 90] degrees"),
+                            ));
+                        }
+                    });
+                }
+                LightDesc::Environment {
+                    filename,
+                    radiance,
+                    scale,
+                    rotate,
+                } => {
+                    if !(scale.is_finite() && *scale > 0.0) {
+                        return Err(bad(
+                            self,
+                            &format!("scale = {scale} must be finite and > 0"),
+                        ));
+                    }
+                    let r = Vec3::from(*rotate);
+                    if !r.is_finite() {
+                        return Err(bad(self, "rotate must be finite"));
+                    }
+                    let to_world = Mat3::from_rotation_z(r.z.to_radians())
+                        * Mat3::from_rotation_y(r.y.to_radians())
+                        * Mat3::from_rotation_x(r.x.to_radians());
+                    let env = match (filename, radiance) {
+                        (Some(_), Some(_)) | (None, None) => {
+                            return Err(bad(
+                                self,
+                                "give either filename (an image) or radiance (a constant colour)",
+                            ));
+                        }
+                        (None, Some(c)) => EnvMap::constant(Vec3::from(*c), *scale, to_world)
+                            .map_err(|e| bad(self, &e))?,
+                        (Some(f), None) => {
+                            let path = self.dir.join(f);
+                            let bytes = read_regular(&path).map_err(|e| {
+                                bad(
+                                    self,
+                                    &format!(
+                                        "environment map `{f}` ({}): cannot read it: {e}",
+                                        path.display()
+                                    ),
+                                )
+                            })?;
+                            self.hash.write(&bytes);
+                            let t = Texture::decode(&bytes, &path).map_err(|e| {
+                                bad(
+                                    self,
+                                    &format!("environment map `{f}` ({}): {e}", path.display()),
+                                )
+                            })?;
+                            EnvMap::from_image(t.width, t.height, t.texels, *scale, to_world)
+                                .map_err(|e| bad(self, &format!("environment map `{f}`: {e}")))?
+                        }
+                    };
+                    out.push(InfiniteLight::Environment(Box::new(env)));
+                }
+            }
         }
         Ok(out)
     }

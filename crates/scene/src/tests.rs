@@ -1014,7 +1014,10 @@ fn textures_decode_to_linear_and_filter_bilinearly() {
     ));
     // Not an image, or an empty one: one line saying so.
     let e = Texture::decode(b"P3 this is not an image", Path::new("t.png")).unwrap_err();
-    assert!(e.contains("not a PNG, JPEG, TGA or EXR"), "{e}");
+    assert!(
+        e.contains("not a PNG, JPEG, TGA, EXR or Radiance HDR"),
+        "{e}"
+    );
 }
 
 /// The albedo of `scene` seen straight down at `(x, z)` of the y = 0 floor.
@@ -1185,7 +1188,7 @@ fn missing_or_broken_textures_are_named() {
     );
     let e = with("map_Kd t.png", Some(b"not an image at all"));
     assert!(
-        e.contains("t.png") && e.contains("not a PNG, JPEG, TGA or EXR"),
+        e.contains("t.png") && e.contains("not a PNG, JPEG, TGA, EXR or Radiance HDR"),
         "{e}"
     );
     let e = with("map_Kd -s 2 2 1 t.png", None);

@@ -27,9 +27,9 @@ pub fn srgb_to_linear(c: f32) -> f32 {
 }
 
 impl Texture {
-    /// Decodes a PNG, JPEG, TGA or EXR file's bytes. Integer images are sRGB-encoded (what image files hold
+    /// Decodes a PNG, JPEG, TGA, EXR or Radiance HDR file's bytes. Integer images are sRGB-encoded (what image files hold
     /// unless they say otherwise, and what Mitsuba 3 assumes of them) and decoded to linear;
-    /// float images (EXR) are linear already. Grey images are read as equal channels; alpha
+    /// float images (EXR, HDR) are linear already. Grey images are read as equal channels; alpha
     /// is not read (`map_Kd` is a colour, and MTL's `map_d` is the transparency). `Err` is one
     /// line saying what is wrong, without the path (the caller names the file).
     /// `name` is the file's name: TGA files carry no signature, so their extension tells.
@@ -45,9 +45,9 @@ impl Texture {
             }
             Ok::<_, String>(r)
         };
-        let (w, h) = reader()?
-            .into_dimensions()
-            .map_err(|e| format!("not a PNG, JPEG, TGA or EXR image photonflow can read: {e}"))?;
+        let (w, h) = reader()?.into_dimensions().map_err(|e| {
+            format!("not a PNG, JPEG, TGA, EXR or Radiance HDR image photonflow can read: {e}")
+        })?;
         if w == 0 || h == 0 {
             return Err(format!("the image is empty ({w}x{h})"));
         }
