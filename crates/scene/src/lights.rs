@@ -337,7 +337,8 @@ impl LightTable {
             let c = 0.5 * (bounds.min + bounds.max);
             (c, (bounds.max - c).length())
         };
-        if !infinite.is_empty() && !(radius.is_finite() && radius > 0.0) {
+        let radius_ok = radius.is_finite() && radius > 0.0;
+        if !infinite.is_empty() && !radius_ok {
             return None;
         }
         let disc = std::f64::consts::PI * (radius as f64).powi(2);
