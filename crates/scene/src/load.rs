@@ -113,7 +113,8 @@ impl Scene {
     }
 
     pub fn light_area(&self) -> f64 {
-        self.lights.iter().map(|l| l.area as f64).sum()
+        // Folded from +0.0: an empty `sum` of f64 is -0.0, which `info` would print.
+        self.lights.iter().fold(0.0, |a, l| a + l.area as f64)
     }
 
     pub fn material_of(&self, name: &str) -> Option<u32> {
