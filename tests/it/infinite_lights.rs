@@ -281,8 +281,10 @@ fn sphere_scene(dir: &TempDir, light: &str, res: u32, extra: &str) -> Scene {
     Scene::from_toml(&dir.path().join("s.toml"), &text).unwrap_or_else(|e| panic!("{e}"))
 }
 
+type Pixels = Vec<(usize, usize)>;
+
 /// Pixels whose footprint lies wholly on the sphere, and wholly off it.
-fn sphere_pixels(scene: &Scene) -> (Vec<(usize, usize)>, Vec<(usize, usize)>) {
+fn sphere_pixels(scene: &Scene) -> (Pixels, Pixels) {
     let (mut on, mut off) = (Vec::new(), Vec::new());
     for (x, y) in all_pixels(scene) {
         let hits = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)]

@@ -1440,13 +1440,12 @@ fn bad_delta_lights_are_named() {
     }
 }
 
+/// An EXR file to write beside a scene: name, width, height and texel function.
+type ExrFile<'a> = (&'a str, u32, u32, &'a dyn Fn(u32, u32) -> [f32; 3]);
+
 /// The good scene with its lamp dark, `lights` added and `exr` (name, width, height, texel
 /// function) written beside it as a float EXR.
-fn infinite_scene(
-    name: &str,
-    lights: &str,
-    exr: Option<(&str, u32, u32, &dyn Fn(u32, u32) -> [f32; 3])>,
-) -> (Scratch, Scene) {
+fn infinite_scene(name: &str, lights: &str, exr: Option<ExrFile>) -> (Scratch, Scene) {
     let mtl = GOOD_MTL.replace("Ke 4 4 4", "Ke 0 0 0");
     let toml = scene_toml("a.obj") + lights;
     let dir = Scratch::new(
@@ -1498,12 +1497,7 @@ fn infinite_light_power_and_photons() {
     let l = DVec3::new(0.25, 0.5, 1.0);
     let alpha = 5f64.to_radians();
     let grad = |x: u32, y: u32| [1.0 + x as f32, 0.5 + 2.0 * y as f32, 3.0 + (x * y) as f32];
-    let cases: [(
-        &str,
-        String,
-        Option<(&str, u32, u32, &dyn Fn(u32, u32) -> [f32; 3])>,
-        DVec3,
-    ); 5] = [
+    let cases: [(&str, String, Option<ExrFile>, DVec3); 5] = [
         (
             "directional",
             "type = \"directional\"\ndirection = [1, -2, 0.5]\nirradiance = [1, 2, 3]\n".into(),
