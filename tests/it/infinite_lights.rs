@@ -92,7 +92,9 @@ fn run(scene: &Scene, o: Overrides, dir: &TempDir) -> Rendered {
 
 /// The path tracer: next-event estimation alone lights the floor (its bounces escape into
 /// nothing: a directional light is never hit), so every pixel is `ρ/π E cos θ` to f32
-/// rounding. Measured: worst pixel 3.7e-8 relative (16 x 16, 4 spp). TRIED_DIRECTIONAL
+/// rounding. Measured: worst pixel 3.7e-8 relative (16 x 16, 4 spp). Tried: the
+/// directional light's NEE direction flipped (`sample` giving `-to_light`) blacks every
+/// pixel (miss 1.0).
 #[test]
 fn directional_light_over_a_plane_path_tracer() {
     let dir = TempDir::new("directional-plane");
@@ -126,7 +128,10 @@ fn directional_light_over_a_plane_path_tracer() {
 /// count per area; the image mean against `ρ/π E cos θ`, within 4 se plus 1.5% for the
 /// density estimates' bias. Measured (16 x 16): SPPM with NEE exact (0 off, sd 0); SPPM by
 /// photons (8 x 20000) 0.58% off (se 0.38%, pixel sd 6.1%); global-direct (200000 photons)
-/// 0.92% off (se 0.23%, pixel sd 3.7%). TRIED_PHOTONS
+/// 0.92% off (se 0.23%, pixel sd 3.7%). Tried: with the
+/// directional light's direction flipped SPPM with NEE misses by 100% (the photon cases were
+/// not reached in that run; the photons' disc area `R²` for `π R²` fails the photon sums in
+/// `scene`'s `infinite_light_power_and_photons` by 68%).
 #[test]
 fn directional_light_over_a_plane_photon_methods() {
     let dir = TempDir::new("directional-plane-photons");
@@ -186,7 +191,8 @@ fn directional_light_over_a_plane_photon_methods() {
 /// `E cos θ` (a cap's `∫ cos dω = π sin²α cos θ`), and the path tracer (NEE in the cone with
 /// MIS against BSDF rays that hit the disc) converges to `ρ/π E cos θ`. Measured (16 x 16,
 /// 16 spp): mean 2e-5 off (se 8e-5), pixel sd 0.13%, worst pixel 0.39%; bounds 4 se, sd
-/// 1%, worst 6%. TRIED_SUN
+/// 1%, worst 6%. Tried: the sun's radiance `E / sin²α` (no `π`), together with escaped
+/// rays unweighted by MIS, fails it (mean 510% off).
 #[test]
 fn sun_disc_over_a_plane_path_tracer() {
     let dir = TempDir::new("sun-plane");
@@ -215,7 +221,8 @@ fn sun_disc_over_a_plane_path_tracer() {
 
 /// A camera looking at the 5-degree sun disc sees `E / (π sin²α)` in every pixel whose
 /// footprint lies inside the disc and nothing in those outside. Measured (32 x 32, vfov 20):
-/// 120 pixels inside at `E / (π sin²α)` to 1e-5, 740 outside exactly 0. TRIED_SUN
+/// 120 pixels inside at `E / (π sin²α)` to 1e-5, 740 outside exactly 0. Tried: the sun's
+/// radiance `E / sin²α` (no `π`) fails the pixels inside the disc.
 #[test]
 fn sun_disc_seen_by_the_camera() {
     let dir = TempDir::new("sun-camera");
@@ -400,7 +407,9 @@ fn sphere_under_constant_environment(name: &str, light: &str) {
 /// Measured (24 x 24, 188 sphere and 320 background pixels, the background exact): path
 /// 16 spp mean 0.18% off (se 0.24%, pixel sd 3.2%, worst 9.4%), path+splat the same bits;
 /// SPPM (256 x 2000, NEE) 1.3% off (se 0.61%, pixel sd 8.4%: NEE alone, no BSDF sampling);
-/// SPPM by photons (64 x 50000) 0.30% off (se 0.12%). TRIED_SPHERE
+/// SPPM by photons (64 x 50000) 0.30% off (se 0.12%). Tried: escaped rays after a
+/// bounce counted without their MIS weight (`escaped_mis` returning `le`: NEE and BSDF
+/// sampling both count the environment) brightens the sphere by 17.8% (se 0.18%).
 #[test]
 fn sphere_under_a_constant_environment() {
     sphere_under_constant_environment(
