@@ -196,6 +196,28 @@ fn damage_photons(d: &Path, f: impl Fn(Vec<u8>) -> Option<Vec<u8>>) {
     }
 }
 
+/// A case whose scene adds one `[[light]]` (`light`, TOML) beside `extra` files, refused at
+/// loading with `words`; the render writes nothing.
+fn light_case(
+    name: &'static str,
+    light: &str,
+    extra: Vec<(&'static str, Input)>,
+    words: &'static [&'static str],
+) -> Case {
+    let mut f = files(scene(&format!("[[light]]\n{light}\n")), OBJ, MTL);
+    f.extend(extra);
+    Case {
+        name,
+        files: f,
+        setup: vec![],
+        prepare: None,
+        args: "render {d}/s.toml --method path --spp 1 --threads 1 --out {d}/out",
+        code: 1,
+        words,
+        check: absent("out"),
+    }
+}
+
 fn cases() -> Vec<Case> {
     let global = |extra: &str| scene(&format!("[estimate.global]\n{extra}\n"));
     let mut nan = grey(16, 16);
@@ -997,6 +1019,124 @@ fn cases() -> Vec<Case> {
             words: &["s.toml: light 0 (spot): look_at must be finite and differ from position"],
             check: absent("out"),
         },
+        light_case(
+            "a directional light of zero direction",
+            "type = \"directional\"\ndirection = [0, 0, 0]\nirradiance = [1, 1, 1]",
+            vec![],
+            &["s.toml: light 0 (directional): direction must be finite and not zero"],
+        ),
+        light_case(
+            "a directional light of NaN direction",
+            "type = \"directional\"\ndirection = [0, nan, 0]\nirradiance = [1, 1, 1]",
+            vec![],
+            &["s.toml: light 0 (directional): direction must be finite and not zero"],
+        ),
+        light_case(
+            "a directional light of negative irradiance",
+            "type = \"directional\"\ndirection = [0, -1, 0]\nirradiance = [1, -1, 1]",
+            vec![],
+            &["s.toml: light 0 (directional): irradiance must be finite and >= 0"],
+        ),
+        light_case(
+            "a directional light of NaN irradiance",
+            "type = \"directional\"\ndirection = [0, -1, 0]\nirradiance = [nan, 1, 1]",
+            vec![],
+            &["s.toml: light 0 (directional): irradiance must be finite and >= 0"],
+        ),
+        light_case(
+            "a directional light of zero irradiance",
+            "type = \"directional\"\ndirection = [0, -1, 0]\nirradiance = [0, 0, 0]",
+            vec![],
+            &["s.toml: light 0 (directional): irradiance must not be zero"],
+        ),
+        light_case(
+            "a sun disc of angular radius 0",
+            "type = \"directional\"\ndirection = [0, -1, 0]\nirradiance = [1, 1, 1]\nangular_radius = 0",
+            vec![],
+            &["s.toml: light 0 (directional): angular_radius = 0 must be in (0, 90] degrees"],
+        ),
+        light_case(
+            "a sun disc of angular radius 120",
+            "type = \"directional\"\ndirection = [0, -1, 0]\nirradiance = [1, 1, 1]\nangular_radius = 120",
+            vec![],
+            &["s.toml: light 0 (directional): angular_radius = 120 must be in (0, 90] degrees"],
+        ),
+        light_case(
+            "an environment with both a file and a radiance",
+            "type = \"environment\"\nfilename = \"env.exr\"\nradiance = [1, 1, 1]",
+            vec![("env.exr", Input::Exr(grey(8, 4)))],
+            &["s.toml: light 0 (environment): give either filename (an image) or radiance"],
+        ),
+        light_case(
+            "an environment with neither a file nor a radiance",
+            "type = \"environment\"\nscale = 2",
+            vec![],
+            &["s.toml: light 0 (environment): give either filename (an image) or radiance"],
+        ),
+        light_case(
+            "an environment map that is missing",
+            "type = \"environment\"\nfilename = \"nope.exr\"",
+            vec![],
+            &[
+                "s.toml: light 0 (environment): environment map `nope.exr`",
+                "cannot read it",
+            ],
+        ),
+        light_case(
+            "an environment map that is not an image",
+            "type = \"environment\"\nfilename = \"env.exr\"",
+            vec![("env.exr", text("not an image\n"))],
+            &[
+                "s.toml: light 0 (environment): environment map `env.exr`",
+                "not a PNG, JPEG, TGA, EXR or Radiance HDR image",
+            ],
+        ),
+        light_case(
+            "a 1x1 environment map",
+            "type = \"environment\"\nfilename = \"env.exr\"",
+            vec![("env.exr", Input::Exr(grey(1, 1)))],
+            &[
+                "s.toml: light 0 (environment): environment map `env.exr`: a 1x1 environment \
+                 map is smaller than 2x3 texels",
+            ],
+        ),
+        light_case(
+            "a black environment map",
+            "type = \"environment\"\nfilename = \"env.exr\"",
+            vec![("env.exr", Input::Exr(Image::from_fn(8, 4, |_, _| [0.0; 3])))],
+            &[
+                "s.toml: light 0 (environment): environment map `env.exr`: the environment map \
+                 is black everywhere",
+            ],
+        ),
+        light_case(
+            "an environment of negative scale",
+            "type = \"environment\"\nradiance = [1, 1, 1]\nscale = -1",
+            vec![],
+            &["s.toml: light 0 (environment): scale = -1 must be finite and > 0"],
+        ),
+        light_case(
+            "an environment of NaN rotation",
+            "type = \"environment\"\nradiance = [1, 1, 1]\nrotate = [0, nan, 0]",
+            vec![],
+            &["s.toml: light 0 (environment): rotate must be finite"],
+        ),
+        light_case(
+            "an environment of negative radiance",
+            "type = \"environment\"\nradiance = [1, -1, 1]",
+            vec![],
+            &[
+                "s.toml: light 0 (environment): the environment radiance",
+                "must be finite and non-negative",
+            ],
+        ),
+        light_case(
+            "the second light of two, an environment, is named by its index",
+            "type = \"point\"\nposition = [0, 1, 0]\nintensity = [1, 1, 1]\n[[light]]\n\
+             type = \"environment\"\nradiance = [1, 1, 1]\nscale = 0",
+            vec![],
+            &["s.toml: light 1 (environment): scale = 0 must be finite and > 0"],
+        ),
         Case {
             name: "a light of unknown type",
             files: files(

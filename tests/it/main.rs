@@ -17,6 +17,10 @@
 //!   degenerate triangles, a sphere of radius 1e-4 (also seen up close), light power near the
 //!   f32 limit): every image finite, closed forms, flux and invariances where the scene
 //!   allows a check.
+//! - `infinite_lights`: directional, sun disc and environment lights against closed forms
+//!   (`ρ/π E cos θ` on a plane in the path tracer and the photon methods, a sun disc's
+//!   irradiance and radiance, a diffuse sphere under a constant environment, colour or image,
+//!   at `ρ L` with the background at `L`).
 //! - `point_lights`: point and spot lights against closed forms (`ρ/π I cos θ / r²` over a
 //!   plane in the path tracer and SPPM, a spot's beam, ramp and cutoff), and a point light in
 //!   the glass sphere whose light only photons find.
@@ -53,6 +57,7 @@ mod evidence;
 mod fuzz;
 mod glass;
 mod hard_cases;
+mod infinite_lights;
 mod kit;
 mod photon_maps;
 mod photons;

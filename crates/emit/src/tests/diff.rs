@@ -411,3 +411,82 @@ fn emission_footprints_are_the_photons_share_of_area_and_solid_angle() {
         }
     }
 }
+
+/// Differentials of photons from delta and infinite lights. A directional light's photons
+/// start on a disc of radius `R` facing it: each owns `π R² / (p N)` of it, so
+/// `|∂o| = R / sqrt(p N)` along the disc's tangents, and they are parallel (no direction
+/// spread), so the footprint keeps its area along the way. A sun disc's photons spread over
+/// its cone: `|∂d/∂u × ∂d/∂v| = 2 (1 - cos α) / (p N)` (the cell over π, as for every light).
+/// A point light's photons start at a point with a `4 / (p N)` spread, so after a distance `t`
+/// the footprint is `t²` times it (doubling `t` quadruples it). Measured: all within the
+/// 1e-5 (1e-4 after a transfer) relative bounds, over 947 directional, 469 sun and 758 point
+/// photons. Tried: `rho_x` without the `sqrt(p N)` fails the directional footprint area by
+/// a factor of 1920 (`p N`).
+#[test]
+fn infinite_and_point_light_footprints() {
+    let s = 1.7f32;
+    let photons = 5000u64;
+    let n = photons as f64;
+    let extra = "[[light]]\ntype = \"directional\"\ndirection = [0.3, -1, 0.2]\nirradiance = [2, 2, 2]\n\
+                 [[light]]\ntype = \"directional\"\ndirection = [-0.3, -1, 0.1]\nirradiance = [1, 1, 1]\n\
+                 angular_radius = 3\n[[light]]\ntype = \"point\"\nposition = [0, 3, 0]\n\
+                 intensity = [50, 50, 50]\n";
+    let scene = super::load_with("cornell-spheres/analytic.toml", extra);
+    let lights = scene.light_table.clone();
+    let r = lights.scene_radius() as f64;
+    let b = scene.geometry.bounds();
+    assert!((r - (0.5 * (b.max - b.min)).length() as f64).abs() < 1e-4 * r);
+    let mut rng = Rng::new(3);
+    let mut seen = [0usize; 3];
+    for _ in 0..3000 {
+        let (e, rd) = emit_diff(
+            &lights,
+            rng.uniform(),
+            rng.uniform2(),
+            rng.uniform2(),
+            photons,
+            s,
+        );
+        let p = lights.pmf(e.light);
+        let s2 = (s * s) as f64;
+        let area = rd.footprint_area() as f64;
+        let spread = rd.spread_solid_angle() as f64;
+        assert_eq!((rd.o, rd.d), (e.ray.o, e.ray.d));
+        match lights.infinite(e.light) {
+            Some(l) if l.is_delta() => {
+                seen[0] += 1;
+                let want = r * r / (p * n) * s2;
+                assert!((area / want - 1.0).abs() < 1e-5, "{area} vs {want}");
+                let rho = r / (p * n).sqrt() * s as f64;
+                for dx in [rd.dodu, rd.dodv] {
+                    assert!((dx.length() as f64 / rho - 1.0).abs() < 1e-5);
+                    assert!(dx.dot(rd.d).abs() < 1e-5 * dx.length());
+                }
+                assert_eq!((rd.dddu, rd.dddv), (Vec3::ZERO, Vec3::ZERO));
+                // Parallel photons: the same footprint on a plane across the beam far on.
+                let t = transfer(&rd, 7.0, -rd.d);
+                assert!((t.footprint_area() as f64 / area - 1.0).abs() < 1e-4);
+            }
+            Some(_) => {
+                seen[1] += 1;
+                let want_a = r * r / (p * n) * s2;
+                assert!((area / want_a - 1.0).abs() < 1e-5, "{area} vs {want_a}");
+                let want_w = 2.0 * (1.0 - 3f64.to_radians().cos()) / (p * n) * s2;
+                assert!((spread / want_w - 1.0).abs() < 1e-4, "{spread} vs {want_w}");
+            }
+            None if lights.delta(e.light).is_none() => {} // the Cornell lamp
+            None => {
+                seen[2] += 1;
+                assert_eq!(area, 0.0);
+                let want_w = 4.0 / (p * n) * s2;
+                assert!((spread / want_w - 1.0).abs() < 1e-5, "{spread} vs {want_w}");
+                let a1 = transfer(&rd, 0.5, -rd.d).footprint_area() as f64;
+                let a2 = transfer(&rd, 1.0, -rd.d).footprint_area() as f64;
+                assert!((a1 / (0.25 * spread) - 1.0).abs() < 1e-4, "{a1} {spread}");
+                assert!((a2 / a1 - 4.0).abs() < 1e-3, "{a1} {a2}");
+            }
+        }
+    }
+    eprintln!("footprints: {seen:?} photons from the directional, sun and point lights");
+    assert!(seen.iter().all(|&k| k > 100), "{seen:?}");
+}
