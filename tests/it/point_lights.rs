@@ -253,16 +253,12 @@ fn point_light_in_glass_only_photons_find_the_caustic() {
 }
 
 /// A point light above the glass sphere (the area light off): the path tracer's caustic
-/// layers are exactly zero (no ray hits a point light, and NEE through glass is blocked), so
-/// nothing is counted twice when splatting adds the caustic: `path+splat` is `path` plus
-/// `caustic-splat`, layer by layer; and in the caustic under the sphere `path+splat` and
-/// SPPM roughly agree. Measured (32 x 32, 16 spp, 2 x 100000 splatted photons): the path
-/// layers of path+splat are the path tracer's to the bit; the whole image of path+splat is
-/// path + caustic-splat to 1.05%; but the caustic layers differ by 24% (caustic, 2.53
-/// against 3.28 summed) and 2.3% (caustic_indirect), and SPPM's caustic region (8 pixels)
-/// is 14.8% above path+splat's: one run each, the noise of these not measured, so the
-/// bounds below (5% whole image, 30% caustic) are loose and the caustic gap is reported,
-/// not explained.
+/// layers are exactly zero (no ray hits a point light, and NEE through glass is blocked),
+/// and path+splat's path layers (emitted, direct, indirect) are the path tracer's to the
+/// bit, so nothing the splats add is counted twice; the splatted caustic layers are what
+/// path+splat adds, and they are not empty. (Whether the splatted caustic is right in
+/// amount is checked against Mitsuba's light tracer in
+/// `references::a_point_light_caustic_matches_mitsubas_light_tracer`.)
 #[test]
 fn point_light_over_glass_partition() {
     let dir = TempDir::new("point-glass-partition");
@@ -317,8 +313,6 @@ fn point_light_over_glass_partition() {
         names(&ps),
         names(&cs)
     );
-    let total = |r: &render::Rendered| crate::kit::sum_layers(r, |_| true);
-    let (p_all, ps_all, cs_all) = (total(&path), total(&ps), total(&cs));
     // Layer by layer over the image: path+splat's path layers against the path tracer's,
     // its caustic layers against caustic-splat's.
     let sum = |img: &film::Image| -> DVec3 { dvec3s(img).iter().sum() };
@@ -335,13 +329,9 @@ fn point_light_over_glass_partition() {
             sum(layer(&path, l))
         };
         let got = sum(layer(&ps, l));
-        let rel = ((got - want).abs() / want.max(DVec3::splat(1e-9))).max_element();
-        eprintln!("point light over glass: {l}: path+splat {got}, alone {want}: {rel:.2e}");
+        eprintln!("point light over glass: {l}: path+splat {got}, alone {want}");
         if l.starts_with("caustic") {
-            assert!(
-                got.min_element() > 0.0 && rel < 0.3,
-                "{l}: {got} against {want}"
-            );
+            assert!(got.min_element() > 0.0, "{l}: path+splat splatted nothing");
         } else {
             assert_eq!(
                 got, want,
@@ -349,41 +339,4 @@ fn point_light_over_glass_partition() {
             );
         }
     }
-    let (a, b) = (sum(&ps_all), sum(&p_all) + sum(&cs_all));
-    let rel = ((a - b).abs() / b).max_element();
-    eprintln!(
-        "point light over glass: whole image: path+splat {a}, path + caustic-splat {b}: {rel:.2e}"
-    );
-    assert!(rel < 0.05, "{a} against {b}");
-    let n = scene.camera.width as usize;
-    let cs_caustic = layer(&cs, "caustic");
-    let max_caustic = dvec3s(cs_caustic)
-        .iter()
-        .map(|v| v.max_element())
-        .fold(0.0, f64::max);
-    let caustic_px: Vec<(usize, usize)> = (0..n)
-        .flat_map(|y| (0..n).map(move |x| (x, y)))
-        .filter(|&p| pixel(cs_caustic, p).max_element() > 0.3 * max_caustic)
-        .collect();
-    let sppm = render(
-        &scene,
-        &Overrides {
-            method: Some(Method::Sppm),
-            passes: Some(16),
-            photons: Some(100_000),
-            ..Overrides::default()
-        },
-        &cache,
-        None,
-    );
-    let s_all = total(&sppm);
-    let a = crate::kit::region_mean(&ps_all, &caustic_px);
-    let b = crate::kit::region_mean(&s_all, &caustic_px);
-    let rel = ((a - b).abs() / b).max_element();
-    eprintln!(
-        "point light over glass: caustic region of {} pixels: path+splat {a}, sppm {b}: {rel:.3}",
-        caustic_px.len()
-    );
-    assert!(caustic_px.len() >= 4, "{}", caustic_px.len());
-    assert!(rel < 0.3, "caustic region: path+splat {a} against sppm {b}");
 }
