@@ -91,29 +91,20 @@ pub fn emit_diff(
 ) -> (Emitted, RayDiff) {
     let e = sampler.emit(u_light, u_pos, u_dir, photons);
     let n = photons.max(1) as f64;
-    if let Some(l) = sampler.infinite(e.light) {
+    let d = e.ray.d;
+    // Per emitter: the frame whose tangents carry the positional spread `ρ_x`, and the
+    // angular spread `ρ_ω`.
+    let (frame, rho_x, rho_w) = if let Some(l) = sampler.infinite(e.light) {
         // A light at infinity: the origin is uniform on a disc of radius `R` facing the
         // light, a cell of `π R² / (p_i N)`, so `ρ_x = R / sqrt(p_i N)` along the disc's
         // tangents; the direction cell is `1 / (p_i N pdf_dir)` (zero for a directional
         // light: its photons are parallel and their footprint stays the disc's spacing).
-        let d = e.ray.d;
-        let frame = Frame::from_z(-d);
         let pmf = sampler.pmf(e.light);
         let rho_x = (sampler.scene_radius() as f64 / (pmf * n).sqrt()) as f32 * scale;
         let cell = l.direction_cell(-d) / (pmf * n);
         let rho_w = (cell / std::f64::consts::PI).sqrt() as f32 * scale;
-        let (e1, e2) = perpendicular_pair(d, &frame);
-        let rd = RayDiff {
-            o: e.ray.o,
-            d,
-            dodu: rho_x * frame.s,
-            dodv: rho_x * frame.t,
-            dddu: rho_w * e1,
-            dddv: rho_w * e2,
-        };
-        return (e, rd);
-    }
-    if let Some(l) = sampler.delta(e.light) {
+        (Frame::from_z(-d), rho_x, rho_w)
+    } else if let Some(l) = sampler.delta(e.light) {
         // A point or spot light: no positional extent, and a direction cell of solid angle
         // `1 / (N p_i pdf_dir)` (`4π/N` for one point light; for a spot, the cutoff cone's
         // solid angle over its photons), `ρ_ω = sqrt(cell / π)` as for the area light.
@@ -123,24 +114,15 @@ pub fn emit_diff(
         };
         let cell = cone / (sampler.pmf(e.light) * n);
         let rho_w = (cell / std::f64::consts::PI).sqrt() as f32 * scale;
-        let d = e.ray.d;
-        let (e1, e2) = perpendicular_pair(d, &Frame::from_z(d));
-        let rd = RayDiff {
-            o: e.ray.o,
-            d,
-            dodu: Vec3::ZERO,
-            dodv: Vec3::ZERO,
-            dddu: rho_w * e1,
-            dddv: rho_w * e2,
-        };
-        return (e, rd);
-    }
-    let frame = sampler.frame(e.light);
-    let cell = sampler.area(e.light) as f64 / (sampler.pmf(e.light) * n);
-    let rho_x = (cell / std::f64::consts::PI).sqrt() as f32 * scale;
-    let cos = e.ray.d.dot(frame.n).max(MIN_EMIT_COS) as f64;
-    let rho_w = (1.0 / (n * cos)).sqrt() as f32 * scale;
-    let d = e.ray.d;
+        (Frame::from_z(d), 0.0, rho_w)
+    } else {
+        let frame = sampler.frame(e.light);
+        let cell = sampler.area(e.light) as f64 / (sampler.pmf(e.light) * n);
+        let rho_x = (cell / std::f64::consts::PI).sqrt() as f32 * scale;
+        let cos = d.dot(frame.n).max(MIN_EMIT_COS) as f64;
+        let rho_w = (1.0 / (n * cos)).sqrt() as f32 * scale;
+        (frame, rho_x, rho_w)
+    };
     let (e1, e2) = perpendicular_pair(d, &frame);
     let rd = RayDiff {
         o: e.ray.o,

@@ -540,8 +540,9 @@ impl LightTable {
 
     /// `u_light` chooses the light, `u_pos` the point (Heitz's triangle map). A point or spot
     /// light's point is its position, exact (no error bound); `n` is then meaningless.
-    fn sample_point(&self, u_light: f32, u_pos: [f32; 2]) -> LightPoint {
-        let (i, _, _) = self.distribution.sample(u_light);
+    /// The point `u_pos` picks on triangle, point or spot light `i` (chosen by the caller
+    /// from the table's distribution, once).
+    fn sample_point(&self, i: usize, u_pos: [f32; 2]) -> LightPoint {
         if let Some(j) = i.checked_sub(self.entries.len()) {
             let d = &self.deltas[j];
             return LightPoint {
@@ -572,14 +573,15 @@ impl LightTable {
     /// `None` when the point cannot send light to `from` (it sees the light's back or lies in
     /// its plane), which NEE counts as a zero contribution.
     pub fn sample(&self, from: Vec3, u_pick: f32, u: [f32; 2]) -> Option<LightSample> {
-        if let Some(e) = self.infinite_entry(self.distribution.sample(u_pick).0) {
-            return self.sample_infinite(e, from, u_pick, u);
+        let i = self.distribution.sample(u_pick).0;
+        if let Some(e) = self.infinite_entry(i) {
+            return self.sample_infinite(i, e, from, u);
         }
         let LightPoint {
             light: i,
             pmf,
             point,
-        } = self.sample_point(u_pick, u);
+        } = self.sample_point(i, u);
         let to = point.p - from;
         let dist2 = to.length_squared();
         if dist2 <= 0.0 || !dist2.is_finite() {
@@ -628,9 +630,9 @@ impl LightTable {
     /// bounding sphere (pbrt-v4 §12.4: `p + wi · 2R`, here from `from`'s own distance).
     fn sample_infinite(
         &self,
+        i: usize,
         e: &InfiniteEntry,
         from: Vec3,
-        u_pick: f32,
         u: [f32; 2],
     ) -> Option<LightSample> {
         let (wi, le, pdf_dir) = e.light.sample(u);
@@ -645,7 +647,7 @@ impl LightTable {
         }
         let dist = 2.0 * (self.radius + (from - self.center).length());
         Some(LightSample {
-            light: self.distribution.sample(u_pick).0,
+            light: i,
             point: SurfacePoint {
                 p: from + dist * wi,
                 p_err: Vec3::ZERO,
@@ -697,7 +699,7 @@ impl LightTable {
             light: i,
             point,
             pmf,
-        } = self.sample_point(u_light, u_pos);
+        } = self.sample_point(i, u_pos);
         if let Some(l) = self.delta(i) {
             let (d, pdf_dir) = match &l.spot {
                 None => (sample_uniform_sphere(u_dir), 0.25 / std::f64::consts::PI),
