@@ -112,6 +112,10 @@ pub(crate) struct Found {
     pub length: f32,
     /// Unit direction back along the ray that arrived.
     pub wo: Vec3,
+    /// Which split branches led here, as a heap index: 1 for the walk that has not split,
+    /// and at a split `2 b` for reflection, `2 b + 1` for refraction. The same chain of
+    /// choices gives the same number on every pass, so a pixel's points are told apart.
+    pub branch: u32,
 }
 
 #[derive(Clone, Copy)]
@@ -125,6 +129,8 @@ struct Branch {
     /// `count_emission` says, since neither next-event estimation at the vertex the walk
     /// started from nor a caustic map (specular chains only) holds it.
     glossy: bool,
+    /// [`Found::branch`] of the vertices this branch reaches.
+    branch: u32,
 }
 
 /// Most dielectric splits one walk follows: the branches waiting on the stack are never more
@@ -161,6 +167,7 @@ pub(crate) fn first_diffuse(
         depth: 0,
         splits: 0,
         glossy: false,
+        branch: 1,
     });
     let mut len = 1;
     while len > 0 {
@@ -217,6 +224,7 @@ pub(crate) fn first_diffuse(
                     beta: b.beta,
                     length,
                     wo,
+                    branch: b.branch,
                 });
                 continue;
             }
@@ -230,6 +238,7 @@ pub(crate) fn first_diffuse(
                         beta: b.beta / pd,
                         length,
                         wo,
+                        branch: b.branch,
                     });
                     continue;
                 }
@@ -258,7 +267,17 @@ pub(crate) fn first_diffuse(
                 None,
             ]
         };
-        for (s, weight) in samples.into_iter().flatten() {
+        // Split children are numbered as a heap: refraction (first in `samples`) 2 b + 1,
+        // reflection 2 b.
+        for (i, sample) in samples.into_iter().enumerate() {
+            let Some((s, weight)) = sample else {
+                continue;
+            };
+            let branch = match (split, i) {
+                (false, _) => b.branch,
+                (true, 0) => 2 * b.branch + 1,
+                (true, _) => 2 * b.branch,
+            };
             let wi = frame.to_world(s.wi);
             // As in the path tracer: end the path where shading and geometric normals
             // disagree on reflection vs transmission (pbrt-v4 §10.1.1).
@@ -276,6 +295,7 @@ pub(crate) fn first_diffuse(
                 depth: b.depth + 1,
                 splits: b.splits + split as u32,
                 glossy: b.glossy || !s.is_specular(),
+                branch,
             });
             len += 1;
         }

@@ -50,6 +50,10 @@ pub struct SppmSettings {
     /// [`SPPM_BOUNDARY_TOPO`]. Without it the radii, which shrink only as passes^(-1/6),
     /// leave the open rims of a scene a few percent dark after hundreds of passes.
     pub boundary: bool,
+    /// Glass hits of a camera path at which both Fresnel branches get a visible point (each
+    /// with its own statistics), instead of one branch chosen at random per pass; at most
+    /// 8. 0 is the classic one point per pixel and pass.
+    pub splits: u32,
 }
 
 /// The topological test SPPM's boundary correction uses when `[estimate.global] topo` is
@@ -65,6 +69,7 @@ impl Default for SppmSettings {
             radius: 0.0,
             direct: true,
             boundary: true,
+            splits: 2,
         }
     }
 }
@@ -76,7 +81,8 @@ pub struct SplatSettings {
     /// The smoothing parameter `s`: every differential at emission is scaled by it (1 tiles
     /// the lit area about once; larger is smoother).
     pub scale: f32,
-    /// Caustic photon paths emitted (0: `[photons] photons`).
+    /// Caustic photon paths emitted per pass (0: `[photons] photons`). Four passes of 50,000
+    /// by default: the worksheet scene's 200,000 paths, in passes whose footprints shrink.
     pub photons: u64,
     /// Largest footprint semi-axis, in scene units (0: 2% of the scene's bounding diagonal).
     pub max_radius: f32,
@@ -98,19 +104,26 @@ pub struct SplatSettings {
     /// scene units (0: `max_radius`). A diffuse bounce spreads light too widely for finer
     /// detail to matter, and a wide disc keeps the estimate smooth.
     pub indirect_radius: f32,
+    /// Footprints shrink from pass to pass so the mean of the passes converges (Knaus and
+    /// Zwicker 2011, probabilistic progressive photon mapping): pass `j` scales every
+    /// footprint axis, `max_radius` and `indirect_radius` by `sqrt(prod_{i=1..j} (i + alpha)
+    /// / (i + 1))`, about `j^((alpha - 1) / 2)`. In (0, 1]; 1 keeps them fixed (the mean
+    /// then converges to a blurred image).
+    pub alpha: f32,
 }
 
 impl Default for SplatSettings {
     fn default() -> Self {
         SplatSettings {
             scale: 1.0,
-            photons: 0,
+            photons: 50_000,
             max_radius: 0.0,
             splits: 2,
             isotropic_radius: 0.0,
-            passes: 1,
+            passes: 4,
             indirect: true,
             indirect_radius: 0.0,
+            alpha: 2.0 / 3.0,
         }
     }
 }
@@ -373,8 +386,21 @@ impl Settings {
             emit,
             estimate,
         };
+        // Where `--spp` and `--passes` are two counts that progress together (path+splat: the
+        // path tracer's samples and the splatting passes), `--passes N` alone is N of the
+        // method's passes: the samples keep the scene file's ratio to the passes.
+        let mut spp = o.spp;
+        if let (None, Some(n), Some(ks), Some(kp)) = (o.spp, o.passes, flags.spp, flags.passes)
+            && ks != kp
+            && ks.counts_passes()
+            && kp.counts_passes()
+        {
+            let per_pass = ks.get(&s) as f64 / kp.get(&s).max(1) as f64;
+            let v = (n as f64 * per_pass).round().clamp(1.0, ks.max() as f64) as u32;
+            spp = Some(v);
+        }
         for (flag, value, knob) in [
-            ("--spp", o.spp, flags.spp),
+            ("--spp", spp, flags.spp),
             ("--passes", o.passes, flags.passes),
         ] {
             match (value, knob) {
@@ -464,6 +490,12 @@ impl Settings {
                 ));
             }
         }
+        if !(sp.alpha > 0.0 && sp.alpha <= 1.0) {
+            return Err(format!(
+                "estimate.splat.alpha = {} must be in (0, 1]",
+                sp.alpha
+            ));
+        }
         if sp.photons > 1 << 40 {
             return Err(format!(
                 "estimate.splat.photons = {} is absurd (at most 2^40)",
@@ -486,6 +518,12 @@ impl Settings {
             return Err(format!(
                 "estimate.sppm.alpha = {} must be in (0, 1)",
                 sm.alpha
+            ));
+        }
+        if sm.splits > 8 {
+            return Err(format!(
+                "estimate.sppm.splits = {} is absurd (at most 8)",
+                sm.splits
             ));
         }
         check_sppm_radius(sm.radius, scene)

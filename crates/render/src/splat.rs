@@ -95,6 +95,20 @@ pub fn max_radius(scene: &Scene, s: &SplatSettings) -> f32 {
     }
 }
 
+/// The factor on pass `pass`'s footprint axes (0-based): the square root of Knaus and
+/// Zwicker's (2011) `r_{j+1}^2 = r_j^2 (j + alpha) / (j + 1)`. Its square falls about as
+/// `j^(alpha - 1)`, so a pass's bias shrinks while the mean of `J` passes keeps a variance
+/// falling about as `J^(-alpha)`; both go to zero. Computed in f64 from pass 1 on, so the
+/// factor of a pass depends on its number alone (shards, budgets).
+pub fn shrink(alpha: f32, pass: u64) -> f32 {
+    let a = alpha as f64;
+    let mut r2 = 1.0f64;
+    for i in 1..=pass {
+        r2 *= (i as f64 + a) / (i as f64 + 1.0);
+    }
+    r2.sqrt() as f32
+}
+
 /// What a splatting pass needs: the scene, its caustic paths' parameters (`params.photons`
 /// per pass, `params.max_depth`), the splat settings and the indexed eye vertices.
 pub struct Splatter<'a> {
@@ -124,16 +138,19 @@ impl Splatter<'_> {
         if s.indirect && images[1].len() != images[0].len() {
             return Err("splatting caustic_indirect needs an image for it".into());
         }
-        let max_r = max_radius(scene, s);
-        let indirect_r = indirect_radius(scene, s);
+        let shrink = shrink(s.alpha, pass);
+        let max_r = max_radius(scene, s) * shrink;
+        let indirect_r = indirect_radius(scene, s) * shrink;
+        let isotropic_r = s.isotropic_radius * shrink;
+        let scale = s.scale * shrink;
         let work = |range: std::ops::Range<u64>| -> Chunk {
             let n = range.end - range.start;
-            let photons = emit::trace_caustics(scene, params, s.scale, pass, range, s.indirect);
+            let photons = emit::trace_caustics(scene, params, scale, pass, range, s.indirect);
             let (first, bounced): (Vec<CausticPhoton>, Vec<CausticPhoton>) =
                 photons.into_iter().partition(|p| p.diffuse == 1);
             let mut out = [Vec::new(), Vec::new()];
             let mut scratch = Scratch::default();
-            let first_params = SplatParams::new(max_r, s.isotropic_radius);
+            let first_params = SplatParams::new(max_r, isotropic_r);
             let bounced_params = SplatParams::new(indirect_r, indirect_r);
             let (first, bounced) = (first.iter(), bounced.iter());
             splat(

@@ -132,6 +132,15 @@ fn mass_on_surface(
     kernel_mass_on_surface(scene, p, n, r, est).max(MIN_MASS)
 }
 
+/// The statistics of one of a pixel's visible points past a glass split, by its branch
+/// (`eye::VisiblePoint::branch`): each Fresnel branch sees its own surface, so each keeps its
+/// own radius and flux (Hachisuka and Jensen 2009 keep one per visible point).
+struct Split {
+    branch: u32,
+    stats: PixelStats,
+    inside: Option<Inside>,
+}
+
 /// SPPM's image being made pass by pass: per pixel, its statistics (`density::sppm`).
 struct Sppm<'a> {
     run: &'a Run<'a>,
@@ -145,6 +154,9 @@ struct Sppm<'a> {
     stats: Vec<PixelStats>,
     /// Per pixel, the last disc found wholly on its surface (see [`mass_on_surface`]).
     inside: Vec<Option<Inside>>,
+    /// Per pixel, the statistics of its split visible points (empty for a pixel that never
+    /// saw glass), in the order their branches first appeared.
+    splits: Vec<Vec<Split>>,
     passes: u32,
     photons_stored: u64,
     t0: std::time::Instant,
@@ -190,6 +202,7 @@ impl<'a> Sppm<'a> {
             boundary,
             stats: vec![PixelStats::new(r0); pixels],
             inside: vec![None; pixels],
+            splits: (0..pixels).map(|_| Vec::new()).collect(),
             passes: 0,
             photons_stored: 0,
             t0: std::time::Instant::now(),
@@ -216,7 +229,7 @@ impl crate::passes::Progressive for Sppm<'_> {
         let (run, scene, s) = (self.run, self.run.scene, self.run.settings);
         let sp = &s.estimate.sppm;
         let pass = self.passes as u64;
-        let points = eye::visible_points(scene, pass, sp.direct, run.threads);
+        let points = eye::visible_points(scene, pass, sp.direct, sp.splits, run.threads);
         let photons = if self.plan.global {
             pass_photons(scene, &self.params, &self.plan, pass, run.threads())?
         } else {
@@ -228,20 +241,38 @@ impl crate::passes::Progressive for Sppm<'_> {
         let alpha = sp.alpha as f64;
         // Each pixel's update reads only its own statistics: the same for any thread count.
         eye::on_threads(run.threads, || {
+            let r0 = self.r0;
             self.stats
                 .par_iter_mut()
                 .zip(&mut self.inside)
+                .zip(&mut self.splits)
                 .zip(&points)
-                .for_each_init(Vec::new, |scratch, ((st, inside), ps)| {
+                .for_each_init(Vec::new, |scratch, (((st, inside), splits), ps)| {
                     st.add_light(ps.light);
-                    let Some(vp) = ps.point else {
-                        return;
-                    };
-                    let mut e = map.irradiance_within(vp.p, vp.n, st.r, &est, scratch);
-                    if boundary && !scratch.is_empty() {
-                        e /= mass_on_surface(scene, vp.p, vp.n, st.r, &est, inside);
+                    for vp in &ps.points {
+                        let (st, inside) = if vp.branch == 1 {
+                            (&mut *st, &mut *inside)
+                        } else {
+                            let i = match splits.iter().position(|s| s.branch == vp.branch) {
+                                Some(i) => i,
+                                None => {
+                                    splits.push(Split {
+                                        branch: vp.branch,
+                                        stats: PixelStats::new(r0),
+                                        inside: None,
+                                    });
+                                    splits.len() - 1
+                                }
+                            };
+                            let s = &mut splits[i];
+                            (&mut s.stats, &mut s.inside)
+                        };
+                        let mut e = map.irradiance_within(vp.p, vp.n, st.r, &est, scratch);
+                        if boundary && !scratch.is_empty() {
+                            e /= mass_on_surface(scene, vp.p, vp.n, st.r, &est, inside);
+                        }
+                        st.update(scratch.len(), e, vp.weight, alpha);
                     }
-                    st.update(scratch.len(), e, vp.weight, alpha);
                 });
         });
         self.passes += 1;
@@ -269,6 +300,7 @@ impl crate::passes::Progressive for Sppm<'_> {
         let scene = self.run.scene;
         layers(
             &self.stats,
+            &self.splits,
             self.passes,
             scene.camera.width as usize,
             scene.camera.height as usize,
@@ -318,6 +350,7 @@ pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rende
 /// the visible points) and `photons` (everything else), each a mean over passes.
 fn layers(
     stats: &[PixelStats],
+    splits: &[Vec<Split>],
     passes: u32,
     w: usize,
     h: usize,
@@ -327,8 +360,20 @@ fn layers(
     let light = film::Image::from_fn(w, h, |x, y| {
         stats[y * w + x].light_radiance(passes).to_array()
     });
+    // Each point's statistics hold the sum over passes of its weighted estimate, zero in
+    // the passes it was not seen: the pixel is their sum.
     let photons = film::Image::from_fn(w, h, |x, y| {
-        stats[y * w + x].photon_radiance(passes).to_array()
+        let i = y * w + x;
+        let split: glam::DVec3 = splits[i]
+            .iter()
+            .map(|s| s.stats.photon_radiance(passes).as_dvec3())
+            .sum();
+        if split == glam::DVec3::ZERO {
+            return stats[i].photon_radiance(passes).to_array();
+        }
+        (stats[i].photon_radiance(passes).as_dvec3() + split)
+            .as_vec3()
+            .to_array()
     });
     vec![
         Layer {
