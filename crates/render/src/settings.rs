@@ -54,6 +54,12 @@ pub struct SppmSettings {
     /// with its own statistics), instead of one branch chosen at random per pass; at most
     /// 8. 0 is the classic one point per pixel and pass.
     pub splits: u32,
+    /// Each visible point starts from its own radius: the distance to its 128th nearest
+    /// photon of its first pass, within half to four times the global start radius (smaller
+    /// in a caustic, where a wide disc blurs, and wider where photons are sparse, where a
+    /// small one is noisy). Off: every pixel starts from the global radius (Hachisuka and
+    /// Jensen 2009).
+    pub adaptive: bool,
 }
 
 /// The topological test SPPM's boundary correction uses when `[estimate.global] topo` is
@@ -70,6 +76,7 @@ impl Default for SppmSettings {
             direct: true,
             boundary: true,
             splits: 2,
+            adaptive: true,
         }
     }
 }
