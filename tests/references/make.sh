@@ -19,7 +19,7 @@
 #             them: mcguire-original at 256 x 256 (8192 spp per half) and
 #             cornell-spheres-analytic at 512 x 512 (4096 spp per half); needs OUTDIR (they
 #             are not committed)
-# OUTDIR      where the images go (default: this directory)
+# OUTDIR      where the images go and `stats` reads them (default: this directory)
 # `stats` prints the noise figures of the halves present (the tables of README.md).
 #
 # The scenes are read from scenes/*.toml of this repository (camera, and checks that the
