@@ -12,8 +12,14 @@
 #             and draws different random numbers, so its images differ within noise
 # NAME        cornell-spheres-analytic, cornell-spheres-closeup, cornell-glossy, cornell-rough,
 #             cornell-textured, cornell-coloured-glass, furnace, plane-light, corner,
-#             point-caustic, cornell-spot, environment (default: all)
-# SPP_POINT, SPP_SPOT, SPP_ENV  spp per half of the last three (default 24576, 8192, 24576)
+#             point-caustic, cornell-spot, environment, mcguire-original (default: all)
+# SPP_POINT, SPP_SPOT, SPP_ENV  spp per half of point-caustic, cornell-spot, environment
+#             (default 24576, 8192, 24576)
+# BENCH=1     the benchmark references instead of the test ones, for the NAMEs that have
+#             them: mcguire-original at 256 x 256 (8192 spp per half) and
+#             cornell-spheres-analytic at 512 x 512 (4096 spp per half); needs OUTDIR (they
+#             are not committed)
+# OUTDIR      where the images go and `stats` reads them (default: this directory)
 # `stats` prints the noise figures of the halves present (the tables of README.md).
 #
 # The scenes are read from scenes/*.toml of this repository (camera, and checks that the
@@ -32,6 +38,12 @@ PY=$PEERS_PYTHON
 VARIANT=${VARIANT:-llvm_ad_rgb}
 SEED_A=1
 SEED_B=2
+BENCH=${BENCH:-0}
+if [ "$BENCH" = 1 ]; then
+  : "${OUTDIR:?BENCH=1 needs OUTDIR=/path/outside/the/repository}"
+fi
+OUT=${OUTDIR:-$HERE}
+mkdir -p "$OUT"
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 
@@ -163,12 +175,12 @@ render() {
       --camera "$TMP/$name-${w}x$h.json" \
       --width "$w" --height "$h" --spp "$spp" --spp-per-pass "$pp" --seed "$seed" \
       --integrator "$integrator" --max-depth -1 --rr-depth 5 --sampler independent --rfilter box \
-      --variant "$VARIANT" -o "$HERE/$name-${w}x$h-$half.exr"
+      --variant "$VARIANT" -o "$OUT/$name-${w}x$h-$half.exr"
   done
 }
 
 stats() {
-  "$PY" - "$PEERS" "$HERE" <<'EOF'
+  "$PY" - "$PEERS" "$OUT" <<'EOF'
 import glob, os, sys
 import numpy as np
 sys.path.insert(0, sys.argv[1])
@@ -210,12 +222,31 @@ SPP_ENV=${SPP_ENV:-24576}
 P=$PEERS/worksheet
 S=$REPO/scenes
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough cornell-textured cornell-coloured-glass furnace plane-light corner point-caustic cornell-spot environment)
+[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough cornell-textured cornell-coloured-glass furnace plane-light corner point-caustic cornell-spot environment mcguire-original)
+if [ "$BENCH" = 1 ]; then
+  for n in "${names[@]}"; do
+    case $n in
+      cornell-spheres-analytic)
+        # 4096 spp in passes of 64: a pass holds as many samples as the 128 x 128 ones.
+        render $n worksheet "$S/cornell-spheres/analytic.toml" 512 512 4096 64 \
+          "$P/cornell_worksheet_box.obj" --spheres "$P/cornell_worksheet_spheres.json" ;;
+      mcguire-original)
+        render $n obj "$S/mcguire/original.toml" 256 256 8192 256 "$S/mcguire/CornellBox-Original.obj" ;;
+      stats) stats ;;
+      *) echo "no benchmark reference for $n" >&2; exit 2 ;;
+    esac
+  done
+  exit 0
+fi
 for n in "${names[@]}"; do
   case $n in
     cornell-spheres-analytic)
       render $n worksheet "$S/cornell-spheres/analytic.toml" 128 128 8192 1024 \
         "$P/cornell_worksheet_box.obj" --spheres "$P/cornell_worksheet_spheres.json" ;;
+    mcguire-original)
+      # McGuire's OBJ and MTL as they are: illum 2 with Ks 0 everywhere (Lambertian Kd), so
+      # no --glossy; the light's Ke an area emitter on its Kd.
+      render $n obj "$S/mcguire/original.toml" 128 128 8192 1024 "$S/mcguire/CornellBox-Original.obj" ;;
     cornell-glossy)
       # The floor is MTL illum 2: the peers' --glossy mapping (Lambertian Kd + GGX Ks).
       render $n obj-spheres "$S/cornell-glossy/glossy-floor.toml" 128 128 8192 1024 \
