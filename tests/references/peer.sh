@@ -19,7 +19,7 @@
 #
 #   mitsuba       path tracer (llvm_ad_rgb, independent sampler, box filter, no depth limit,
 #                 Russian roulette from depth 5). It has no time limit: the spp come from a
-#                 calibration (two short untimed renders, 2 and 8 spp, cached per scene file
+#                 calibration (two short untimed renders, 4 and 32 spp, cached per scene file
 #                 and size) fitting wall = start-up + spp x seconds per spp, to fill SECONDS.
 #   luxcore      path tracer + PhotonGI caustic cache (100k photons a second of SECONDS, 100k
 #                 to 1M; radius 0.2% of the scene's diagonal: 0.05 in the worksheet), its own
@@ -72,8 +72,8 @@ case $peer in
     cal=$cache/mitsuba-$key-${W}x$H.txt
     if [ ! -s "$cal" ]; then
       t() { local t0; t0=$(date +%s.%N); mi "$1" "$TMP/cal.exr"; echo "$(date +%s.%N) $t0" | awk '{ print $1 - $2 }'; }
-      t2=$(t 2) t8=$(t 8)
-      echo "$t2 $t8" | awk '{b = ($2 - $1) / 6; if (b <= 0) b = 1e-3; a = $1 - 2 * b; if (a < 0) a = 0; print a, b}' > "$cal"
+      t4=$(t 4) t32=$(t 32)
+      echo "$t4 $t32" | awk '{b = ($2 - $1) / 28; if (b <= 1e-3) b = 1e-3; a = $1 - 4 * b; if (a < 0) a = 0; print a, b}' > "$cal"
     fi
     read -r a b < "$cal"
     spp=$(awk -v s="$secs" -v a="$a" -v b="$b" 'BEGIN { n = int((s - a) / b); print (n < 1 ? 1 : n) }')

@@ -292,7 +292,7 @@ fn run_peer(
 }
 
 /// `bench accuracy`: every case at every budget, photonflow's methods and the peers taking
-/// turns, then each case's tables and what each peer ran.
+/// turns (each peer warmed up first), then each case's tables and what each peer ran.
 pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> Result<(), String> {
     if cases.is_empty() {
         return Err("no case: give --case SCENE.toml,REF_A.exr,REF_B.exr or --suite FILE".into());
@@ -331,6 +331,19 @@ pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> 
         let mut ours: Vec<Column> = METHODS.iter().map(|m| column(&m.name())).collect();
         let mut theirs: Vec<Column> = peers.iter().map(|p| column(&p.name)).collect();
         let mut notes: Vec<Option<String>> = vec![None; peers.len()];
+        // A warm-up run of each peer at the smallest budget, untimed: its calibrations and
+        // caches are made and its files read once before the timed runs; a peer that cannot
+        // render the scene is out of every budget.
+        let smallest = budgets.iter().copied().fold(f64::INFINITY, f64::min);
+        let mut out_of: Vec<Option<String>> = Vec::new();
+        for (p, note) in peers.iter().zip(&mut notes) {
+            let exr = case_dir.join(format!("peer-{}-warm-up.exr", p.name));
+            let r = run_peer(p, &scene_abs, smallest, &exr, &halves, note);
+            if let Err(e) = &r {
+                println!("{:<14} warm-up: did not run: {e}", p.name);
+            }
+            out_of.push(r.err());
+        }
         for &b in budgets {
             for (m, col) in METHODS.iter().zip(&mut ours) {
                 let out = case_dir.join(format!("{}-{b}s", m.name().replace('+', "-")));
@@ -341,7 +354,13 @@ pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> 
                 );
                 col.cells.push(Ok(r));
             }
-            for ((p, col), note) in peers.iter().zip(&mut theirs).zip(&mut notes) {
+            for (((p, col), note), out) in
+                peers.iter().zip(&mut theirs).zip(&mut notes).zip(&out_of)
+            {
+                if let Some(e) = out {
+                    col.cells.push(Err(e.clone()));
+                    continue;
+                }
                 let exr = case_dir.join(format!("peer-{}-{b}s.exr", p.name));
                 let r = run_peer(p, &scene_abs, b, &exr, &halves, note);
                 match &r {
@@ -360,7 +379,8 @@ pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> 
         );
         print!("{}", tables(budgets, &ours, &theirs));
         println!(
-            "\nphotonflow: `render --method M --time S` on all cores, photons traced anew per run."
+            "\nphotonflow: `render --method M --time S` on all cores, photons traced anew per run; \
+             each peer ran once untimed at the smallest budget first (calibrations, caches)."
         );
         for ((p, col), note) in peers.iter().zip(&theirs).zip(&notes) {
             let failed: Vec<String> = col.cells.iter().filter_map(|c| c.clone().err()).collect();
