@@ -73,22 +73,40 @@ fn run_teed(root: &Path, exe: &Path, args: &[String]) -> Result<String, String> 
     Ok(String::from_utf8_lossy(&captured).into_owned())
 }
 
-/// The section for one run: heading, command, date, machine, and the output in a fence longer
-/// than any run of backticks inside it.
+/// The section for one run: heading, command, date, machine, and the output in fences longer
+/// than any run of backticks inside it, but for its markdown tables (runs of lines starting
+/// with `|`), which stand outside the fences so that they render as tables.
 pub fn section(bench: &Bench, date: &str, machine: &str, output: &str) -> String {
     let longest = output.split(|c| c != '`').map(str::len).max().unwrap_or(0);
     let fence = "`".repeat(longest.max(2) + 1);
     let typed = shell_words(&bench.typed);
     let args = shell_words(&bench.args);
+    let mut body = String::new();
+    let mut lines: Vec<&str> = output.trim_end().lines().collect();
+    if lines.is_empty() {
+        lines.push("");
+    }
+    for chunk in lines.chunk_by(|a, b| a.starts_with('|') == b.starts_with('|')) {
+        if chunk[0].starts_with('|') {
+            body += &format!("{}\n\n", chunk.join("\n"));
+        } else {
+            // Blank lines around a table belong to no fence.
+            let text = chunk.join("\n");
+            let text = text.trim_matches('\n');
+            if !text.is_empty() || lines.len() == chunk.len() {
+                body += &format!("{fence}text\n{text}\n{fence}\n\n");
+            }
+        }
+    }
     format!(
         "## bench {what}\n\n\
          - command: `cargo xtask bench {typed}`\n\
          - runs: `photonflow {args}` (profile `release-lto`)\n\
          - date: {date}\n\
          - machine: {machine}\n\n\
-         {fence}text\n{output}\n{fence}\n",
+         {body}",
         what = bench.what,
-        output = output.trim_end(),
+        body = body.trim_end_matches('\n').to_string() + "\n",
     )
 }
 

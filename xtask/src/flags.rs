@@ -60,11 +60,17 @@ cargo xtask <command>   (every command builds the release `photonflow` binary an
   bench splat [SCENE] [--photons N] [--runs N]
                       caustic photons splatted per second on 1 and 2 threads, eye vertices,
                       peak memory (default scene: scenes/cornell-spheres/analytic.toml)
-  bench accuracy [SCENE] [--reference EXR] [--reference-spp N] [--peer NAME=CMD]...
-                      the time each method (path+splat, final-gather, sppm, and peers: shell
-                      commands writing an EXR to $OUT) needs to reach the relative MSE of the
-                      256-spp path-traced image, and its ratio to the path tracer's time, in
-                      one run, against a reference rendered once (4096 spp) and cached
+  bench accuracy [--case SCENE.toml,REF_A.exr,REF_B.exr]... [--suite FILE] [--refs DIR]
+                 [--budgets 2,5,15,60] [--peer NAME | --peer NAME=CMD]...
+                      photonflow's sppm, path+splat and path and the peers at fixed time
+                      budgets, in one run: the relative MSE of each image against the
+                      scene's two reference halves, the reference's noise taken out; per
+                      budget the best of each side, the error ratio and photonflow's time to
+                      the best peer's error over the peer's time. Without --case, the suite
+                      scenes/bench-accuracy.toml (its references under --refs DIR). Peers:
+                      tests/references/peer.sh's mitsuba, luxcore, cycles, smallvcm-ppm,
+                      smallvcm-bpt, smallvcm-vcm (set PEERS, PEERS_VENV, BPY_VENV), or shell
+                      commands writing an EXR to $OUT (also given $SCENE, $BUDGET)
   bench knn [--photons N] [--queries N]
                       k-NN queries/s for k = 50, 250, 1000 per index (kd-tree, kiddo, brute),
                       and pixel-order irradiance queries with radius hints
@@ -104,6 +110,7 @@ pub struct Bench {
 
 pub const DEFAULT_SCENE: &str = "scenes/cornell-spheres/tessellated.toml";
 pub const SPLAT_SCENE: &str = "scenes/cornell-spheres/analytic.toml";
+pub const ACCURACY_SUITE: &str = "scenes/bench-accuracy.toml";
 
 pub fn parse(args: &[String]) -> Result<Cmd, String> {
     let a: Vec<&str> = args.iter().map(String::as_str).collect();
@@ -132,10 +139,18 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
             if rest.first().is_none_or(|s| s.starts_with("--")) {
                 match *what {
                     "rays" | "photons" => out.push(DEFAULT_SCENE.into()),
-                    // Splatting and accuracy measure the worksheet scene with exact spheres.
-                    "splat" | "accuracy" => out.push(SPLAT_SCENE.into()),
+                    // Splatting measures the worksheet scene with exact spheres.
+                    "splat" => out.push(SPLAT_SCENE.into()),
                     _ => {}
                 }
+            }
+            // Accuracy takes cases; without any, the committed suite's.
+            let given = |f: &str| {
+                rest.iter()
+                    .any(|s| *s == f || s.starts_with(&format!("{f}=")))
+            };
+            if *what == "accuracy" && !given("--case") && !given("--suite") {
+                out.extend(["--suite".into(), ACCURACY_SUITE.into()]);
             }
             out.extend(rest.iter().map(|s| s.to_string()));
             Ok(Cmd::Bench(Bench {

@@ -27,6 +27,20 @@ fn bench_commands_keep_what_was_typed_and_add_the_default_scene() {
     assert_eq!(b.args, ["bench-photons", "scenes/corner/corner.toml"]);
     let b = bench(&["bench", "store", "--photons", "100"]);
     assert_eq!(b.args, ["bench-store", "--photons", "100"]);
+    // Accuracy takes cases; without one, the committed suite.
+    let b = bench(&["bench", "accuracy", "--budgets", "1,2"]);
+    assert_eq!(
+        b.args,
+        [
+            "bench-accuracy",
+            "--suite",
+            flags::ACCURACY_SUITE,
+            "--budgets",
+            "1,2"
+        ]
+    );
+    let b = bench(&["bench", "accuracy", "--case", "s.toml,a.exr,b.exr"]);
+    assert_eq!(b.args, ["bench-accuracy", "--case", "s.toml,a.exr,b.exr"]);
     assert!(flags::parse(&strings(&["bench", "nope"])).is_err());
 }
 
@@ -92,6 +106,22 @@ fn a_section_holds_command_date_machine_and_fenced_output() {
     // Arguments the shell would split are quoted.
     let b = bench(&["bench", "knn", "--label", "a b"]);
     assert!(section(&b, "", "", "").contains("`cargo xtask bench knn --label 'a b'`"));
+}
+
+#[test]
+fn markdown_tables_in_the_output_stand_outside_the_fences() {
+    let b = bench(&["bench", "accuracy"]);
+    let out = "run 1\n\n| a | b |\n|---|---|\n| 1 | 2 |\n\nnote\n| c |\n";
+    let s = section(&b, "d", "m", out);
+    let body = &s[s.find("```text").unwrap()..];
+    assert_eq!(
+        body,
+        "```text\nrun 1\n```\n\n| a | b |\n|---|---|\n| 1 | 2 |\n\n```text\nnote\n```\n\n| c |\n"
+    );
+    // A section holding tables is still replaced whole.
+    let doc = format!("# B\n\n{s}\n## bench knn\n\nk\n");
+    let again = replace_section(&doc, "accuracy", &s);
+    assert_eq!(again, doc);
 }
 
 /// A whole run with `echo` standing in for photonflow (it prints its arguments), in a scratch

@@ -1,51 +1,145 @@
-//! `bench-accuracy`: the time each method needs to reach the error of a 256-spp path-traced
-//! image, against one long path-traced reference, all in one run (the machines are shared:
-//! only ratios taken together mean anything). Each run is a whole `render` command (photons
-//! traced anew into an empty cache, outputs written), timed from start to finish.
+//! `bench-accuracy`: photonflow's progressive methods and the peer renderers at fixed time
+//! budgets, all in one run (the machines are shared: only figures taken together mean
+//! anything), each image scored against a reference given as two independent halves with the
+//! reference's noise taken out. Each photonflow run is a whole `render --time S` command
+//! (photons traced anew into an empty cache, outputs written), and each peer a whole shell
+//! command, both timed from start to finish.
 
-use render::Photons;
-use render::{Overrides, RenderRequest};
+use render::{Overrides, Photons, RenderRequest};
 use scene::{Method, Scene};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// One rung of a method's ladder: its budget, wall seconds and relative MSE.
-struct Rung {
-    budget: String,
-    seconds: f64,
-    relmse: f64,
+/// photonflow's methods in the table, in its column order.
+pub const METHODS: [Method; 3] = [Method::Sppm, Method::PathSplat, Method::Path];
+
+/// The default budgets, in seconds.
+pub const BUDGETS: [f64; 4] = [2.0, 5.0, 15.0, 60.0];
+
+/// The peers `--peer NAME` names: `tests/references/peer.sh NAME`.
+pub const BUILTIN_PEERS: [&str; 6] = [
+    "mitsuba",
+    "luxcore",
+    "cycles",
+    "smallvcm-ppm",
+    "smallvcm-bpt",
+    "smallvcm-vcm",
+];
+
+/// One scene and the two independent halves of its reference.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Case {
+    pub scene: PathBuf,
+    pub reference_a: PathBuf,
+    pub reference_b: PathBuf,
 }
 
-/// Reads `image.json`'s snapshots of a progressive run: (passes, seconds, relmse).
-fn snapshots(out: &Path) -> Result<Vec<(u32, f64, f64)>, String> {
-    let path = out.join("image.json");
-    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let j: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-    Ok(j["snapshots"]
-        .as_array()
-        .map(|a| {
-            a.iter()
-                .filter_map(|s| {
-                    Some((
-                        s["passes"].as_u64()? as u32,
-                        s["seconds"].as_f64()?,
-                        s["relmse"].as_f64()?,
-                    ))
-                })
-                .collect()
+impl Case {
+    /// `SCENE.toml,REF_A.exr,REF_B.exr` of `--case`.
+    pub fn parse(s: &str) -> Result<Case, String> {
+        match s.split(',').collect::<Vec<_>>().as_slice() {
+            [scene, a, b] if !scene.is_empty() && !a.is_empty() && !b.is_empty() => Ok(Case {
+                scene: scene.into(),
+                reference_a: a.into(),
+                reference_b: b.into(),
+            }),
+            _ => Err(format!("`{s}`: expected SCENE.toml,REF_A.exr,REF_B.exr")),
+        }
+    }
+}
+
+/// The cases of a suite file: `[[case]]` tables with `scene`, `reference_a` and
+/// `reference_b`. Scenes are relative to the suite file, references to `refs` if given (where
+/// the big reference images are kept), else to the suite file too.
+pub fn read_suite(path: &Path, refs: Option<&Path>) -> Result<Vec<Case>, String> {
+    #[derive(serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Suite {
+        case: Vec<Entry>,
+    }
+    #[derive(serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Entry {
+        scene: PathBuf,
+        reference_a: PathBuf,
+        reference_b: PathBuf,
+    }
+    let err = |e: String| format!("{}: {e}", path.display());
+    let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
+    let suite: Suite = toml::from_str(&text).map_err(|e| err(e.to_string()))?;
+    let here = path.parent().unwrap_or(Path::new(""));
+    let refs = refs.unwrap_or(here);
+    Ok(suite
+        .case
+        .into_iter()
+        .map(|e| Case {
+            scene: here.join(e.scene),
+            reference_a: refs.join(e.reference_a),
+            reference_b: refs.join(e.reference_b),
         })
-        .unwrap_or_default())
+        .collect())
 }
 
-/// Seconds at which a ladder first reaches `target`: the first rung at or below it, or
-/// between two rungs, log-log interpolation (error falls as a power of time).
-fn time_to(target: f64, rungs: &[Rung]) -> Option<f64> {
+/// A peer renderer: a shell command that writes a linear EXR of `$SCENE`'s view to `$OUT` in
+/// about `$BUDGET` seconds. It may print a line `settings: ...` (the table's note says what
+/// ran); when it fails, its last line on stderr is the reason shown.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Peer {
+    pub name: String,
+    pub command: String,
+}
+
+impl Peer {
+    /// `NAME=CMD`, or `NAME` of [`BUILTIN_PEERS`]: the repository's peer runner.
+    pub fn parse(s: &str) -> Result<Peer, String> {
+        if let Some((name, command)) = s.split_once('=') {
+            if name.is_empty() || command.is_empty() {
+                return Err(format!("`{s}`: expected NAME=COMMAND or NAME"));
+            }
+            return Ok(Peer {
+                name: name.into(),
+                command: command.into(),
+            });
+        }
+        if !BUILTIN_PEERS.contains(&s) {
+            return Err(format!(
+                "`{s}`: not a built-in peer ({}); give NAME=COMMAND for another",
+                BUILTIN_PEERS.join(", ")
+            ));
+        }
+        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/references/peer.sh");
+        Ok(Peer {
+            name: s.into(),
+            command: format!(
+                "bash '{}' {s} \"$SCENE\" \"$BUDGET\" \"$OUT\"",
+                script.display()
+            ),
+        })
+    }
+}
+
+/// A run: its wall seconds and corrected relative MSE.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rung {
+    pub seconds: f64,
+    pub relmse: f64,
+}
+
+/// A column of the table: a method or peer, one cell per budget (or why it did not run).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Column {
+    pub name: String,
+    pub cells: Vec<Result<Rung, String>>,
+}
+
+/// Seconds at which runs of growing budget first reach `target`: the first at or below it,
+/// or between two, log-log interpolation (error falls as a power of time).
+pub fn time_to(target: f64, rungs: &[Rung]) -> Option<f64> {
     let mut prev: Option<&Rung> = None;
     for r in rungs {
         if r.relmse <= target {
             return Some(match prev {
-                Some(p) if p.relmse > target && r.relmse < p.relmse => {
+                Some(p) if p.relmse > target && r.relmse < p.relmse && r.relmse > 0.0 => {
                     let t = (target.ln() - p.relmse.ln()) / (r.relmse.ln() - p.relmse.ln());
                     (p.seconds.ln() + t * (r.seconds.ln() - p.seconds.ln())).exp()
                 }
@@ -57,26 +151,87 @@ fn time_to(target: f64, rungs: &[Rung]) -> Option<f64> {
     None
 }
 
-/// One `render` command, timed; returns (seconds, relmse against `reference`).
-fn run_one(
+/// The column with the lowest error at budget `i`, and that cell.
+fn best(columns: &[Column], i: usize) -> Option<(&Column, Rung)> {
+    columns
+        .iter()
+        .filter_map(|c| Some((c, *c.cells.get(i)?.as_ref().ok()?)))
+        .min_by(|a, b| a.1.relmse.total_cmp(&b.1.relmse))
+}
+
+/// The markdown tables of one scene: errors per budget and column, then per budget the best
+/// of each side, the peer's error over photonflow's, and photonflow's time to the peer's
+/// error (its best method at that budget, interpolated over its own budgets) over the peer's.
+pub fn tables(budgets: &[f64], ours: &[Column], peers: &[Column]) -> String {
+    let mut s = String::new();
+    let all: Vec<&Column> = ours.iter().chain(peers).collect();
+    s += "| budget |";
+    for c in &all {
+        s += &format!(" {} |", c.name);
+    }
+    s += "\n|---|";
+    s += &"---|".repeat(all.len());
+    for (i, b) in budgets.iter().enumerate() {
+        s += &format!("\n| {b} s |");
+        for c in &all {
+            s += &match c.cells.get(i) {
+                Some(Ok(r)) => format!(" {:.5} ({:.1} s) |", r.relmse, r.seconds),
+                _ => " – |".into(),
+            };
+        }
+    }
+    s += "\n\n| budget | best photonflow | best peer | error ratio (peer / photonflow) \
+          | photonflow's time to the peer's error / peer's time |\n|---|---|---|---|---|";
+    for (i, b) in budgets.iter().enumerate() {
+        let (o, p) = (best(ours, i), best(peers, i));
+        let show = |x: Option<(&Column, Rung)>| {
+            x.map_or("–".into(), |(c, r)| format!("{} {:.5}", c.name, r.relmse))
+        };
+        let (ratio, time) = match (o, p) {
+            (Some((oc, or)), Some((_, pr))) => {
+                let rungs: Vec<Rung> = oc.cells.iter().filter_map(|c| c.clone().ok()).collect();
+                let time = match time_to(pr.relmse, &rungs) {
+                    Some(t) => format!("{:.2} ({t:.1} s / {:.1} s)", t / pr.seconds, pr.seconds),
+                    None => {
+                        let last = rungs.last().map_or(f64::NAN, |r| r.seconds);
+                        format!("> {:.2} (not reached in {last:.1} s)", last / pr.seconds)
+                    }
+                };
+                (format!("{:.2}", pr.relmse / or.relmse), time)
+            }
+            _ => ("–".into(), "–".into()),
+        };
+        s += &format!("\n| {b} s | {} | {} | {ratio} | {time} |", show(o), show(p));
+    }
+    s + "\n"
+}
+
+/// The corrected relative MSE of the image at `exr`.
+fn corrected(halves: &film::Halves, exr: &Path) -> Result<f64, String> {
+    let img = render::output::read_finite(exr, "pixels")?;
+    let m =
+        film::metrics_halves(&img, halves, None).map_err(|e| format!("{}: {e}", exr.display()))?;
+    Ok(m.relmse)
+}
+
+/// One `render --time` command, timed from start to finish.
+fn run_ours(
     scene: &Scene,
     method: Method,
-    spp: Option<u32>,
-    passes: Option<u32>,
+    budget: f64,
     out: &Path,
-    reference: Option<&Path>,
     cache: &Path,
-) -> Result<(f64, f64), String> {
+    halves: &film::Halves,
+) -> Result<Rung, String> {
     // A photon cache left from another run would make tracing free.
     let _ = std::fs::remove_dir_all(cache);
     let t0 = Instant::now();
-    let summary = render::render(
+    render::render(
         scene,
         &RenderRequest {
             overrides: Overrides {
                 method: Some(method),
-                spp,
-                passes,
+                time: Some(budget),
                 ..Overrides::default()
             },
             cache,
@@ -84,212 +239,156 @@ fn run_one(
             threads: None,
             out: out.to_path_buf(),
             exposure: 0.0,
-            reference,
+            reference: None,
             label: None,
         },
     )?;
     let seconds = t0.elapsed().as_secs_f64();
     let _ = std::fs::remove_dir_all(cache);
-    Ok((seconds, summary.metrics.map_or(f64::NAN, |m| m.relmse)))
+    Ok(Rung {
+        seconds,
+        relmse: corrected(halves, &out.join("image.exr"))?,
+    })
 }
 
-/// A peer renderer: a shell command that writes a linear EXR to the path in `$OUT`.
-pub struct Peer {
-    pub name: String,
-    pub command: String,
+/// One peer command, timed; `Err` holds the reason it did not run. `note` gets the peer's
+/// `settings:` line.
+fn run_peer(
+    peer: &Peer,
+    scene: &Path,
+    budget: f64,
+    exr: &Path,
+    halves: &film::Halves,
+    note: &mut Option<String>,
+) -> Result<Rung, String> {
+    let _ = std::fs::remove_file(exr);
+    let t0 = Instant::now();
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(&peer.command)
+        .env("OUT", exr)
+        .env("BUDGET", budget.to_string())
+        .env("SCENE", scene)
+        .output()
+        .map_err(|e| format!("cannot start: {e}"))?;
+    let seconds = t0.elapsed().as_secs_f64();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    if let Some(l) = stdout
+        .lines()
+        .rev()
+        .find_map(|l| l.strip_prefix("settings: "))
+    {
+        *note = Some(l.trim().to_string());
+    }
+    if !out.status.success() {
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let last = stderr.lines().rev().find(|l| !l.trim().is_empty());
+        return Err(last.unwrap_or("no message").trim().to_string());
+    }
+    Ok(Rung {
+        seconds,
+        relmse: corrected(halves, exr)?,
+    })
 }
 
-/// The relative MSE of the image at `exr` with the reference's noise taken out, when the
-/// reference came as two halves (else nothing).
-fn corrected(halves: Option<&film::Halves>, exr: &Path) -> Result<String, String> {
-    let Some(h) = halves else {
-        return Ok(String::new());
-    };
-    let img = render::output::read_finite(exr, "pixels")?;
-    let m = film::metrics_halves(&img, h, None).map_err(|e| format!("{}: {e}", exr.display()))?;
-    Ok(format!("  (reference noise out: {:.5})", m.relmse))
-}
-
-/// `bench accuracy`. `reference_b`: the second independent half of a given `reference`; the
-/// plain errors are then against the halves' mean, each with the reference's noise taken out
-/// beside it (time to the target stays on the plain figures, the path tracer's included).
-pub fn accuracy(
-    path: &Path,
-    given_reference: Option<&Path>,
-    reference_b: Option<&Path>,
-    reference_spp: u32,
-    peers: &[Peer],
-    dir: &Path,
-) -> Result<(), String> {
-    let scene = Scene::load(path).map_err(|e| e.to_string())?;
-    let (reference, halves) = match (given_reference, reference_b) {
-        (Some(a), Some(b)) => {
-            let mean = dir.join("reference-halves-mean.exr");
-            let h = crate::reference::halves(&scene, a, b, &mean)?;
-            (mean, Some(h))
-        }
-        (None, Some(b)) => {
-            return Err(format!(
-                "--reference-b {}: the second half needs the first (--reference)",
-                b.display()
-            ));
-        }
-        _ => (
-            crate::reference::reference(&scene, given_reference, reference_spp, dir, None)?.exr,
-            None,
-        ),
-    };
-    let halves = halves.as_ref();
+/// `bench accuracy`: every case at every budget, photonflow's methods and the peers taking
+/// turns (each peer warmed up first), then each case's tables and what each peer ran.
+pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> Result<(), String> {
+    if cases.is_empty() {
+        return Err("no case: give --case SCENE.toml,REF_A.exr,REF_B.exr or --suite FILE".into());
+    }
+    if budgets.is_empty() || budgets.iter().any(|b| !(*b > 0.0 && b.is_finite())) {
+        return Err(format!("--budgets {budgets:?}: positive seconds"));
+    }
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    // Peers run from anywhere: give them absolute paths.
+    let abs = std::fs::canonicalize(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let cache = dir.join("cache");
-    let mut table: Vec<(String, Vec<Rung>)> = Vec::new();
-    let ladder = |name: &str, method: Method, budgets: &[u32], stop: Option<f64>| {
-        let mut rungs = Vec::new();
+    for (k, case) in cases.iter().enumerate() {
+        let scene = Scene::load(&case.scene).map_err(|e| e.to_string())?;
+        let scene_abs = std::fs::canonicalize(&case.scene)
+            .map_err(|e| format!("{}: {e}", case.scene.display()))?;
+        let case_dir = abs.join(format!("case-{k}"));
+        let halves = crate::reference::halves(
+            &scene,
+            &case.reference_a,
+            &case.reference_b,
+            &case_dir.join("reference-halves-mean.exr"),
+        )?;
+        println!(
+            "\n{} ({}, {}x{}), reference halves {} and {}",
+            scene.file.name,
+            case.scene.display(),
+            scene.camera.width,
+            scene.camera.height,
+            case.reference_a.display(),
+            case.reference_b.display()
+        );
+        let column = |name: &str| Column {
+            name: name.into(),
+            cells: Vec::new(),
+        };
+        let mut ours: Vec<Column> = METHODS.iter().map(|m| column(&m.name())).collect();
+        let mut theirs: Vec<Column> = peers.iter().map(|p| column(&p.name)).collect();
+        let mut notes: Vec<Option<String>> = vec![None; peers.len()];
+        // A warm-up run of each peer at the smallest budget, untimed: its calibrations and
+        // caches are made and its files read once before the timed runs; a peer that cannot
+        // render the scene is out of every budget.
+        let smallest = budgets.iter().copied().fold(f64::INFINITY, f64::min);
+        let mut out_of: Vec<Option<String>> = Vec::new();
+        for (p, note) in peers.iter().zip(&mut notes) {
+            let exr = case_dir.join(format!("peer-{}-warm-up.exr", p.name));
+            let r = run_peer(p, &scene_abs, smallest, &exr, &halves, note);
+            if let Err(e) = &r {
+                println!("{:<14} warm-up: did not run: {e}", p.name);
+            }
+            out_of.push(r.err());
+        }
         for &b in budgets {
-            let out = dir.join(format!("{}-{b}", method.name().replace('+', "-")));
-            let (seconds, relmse) = run_one(
-                &scene,
-                method,
-                Some(b),
-                None,
-                &out,
-                Some(&reference),
-                &cache,
-            )?;
-            let c = corrected(halves, &out.join("image.exr"))?;
-            println!("{name:<13} {b:>5} spp  {seconds:8.2} s  relMSE {relmse:.5}{c}");
-            rungs.push(Rung {
-                budget: format!("{b} spp"),
-                seconds,
-                relmse,
-            });
-            if stop.is_some_and(|t| relmse <= t) {
-                break;
+            for (m, col) in METHODS.iter().zip(&mut ours) {
+                let out = case_dir.join(format!("{}-{b}s", m.name().replace('+', "-")));
+                let r = run_ours(&scene, *m, b, &out, &cache, &halves)?;
+                println!(
+                    "{:<14} {b:>5} s budget {:8.2} s  relMSE {:.5}",
+                    col.name, r.seconds, r.relmse
+                );
+                col.cells.push(Ok(r));
+            }
+            for (((p, col), note), out) in
+                peers.iter().zip(&mut theirs).zip(&mut notes).zip(&out_of)
+            {
+                if let Some(e) = out {
+                    col.cells.push(Err(e.clone()));
+                    continue;
+                }
+                let exr = case_dir.join(format!("peer-{}-{b}s.exr", p.name));
+                let r = run_peer(p, &scene_abs, b, &exr, &halves, note);
+                match &r {
+                    Ok(r) => println!(
+                        "{:<14} {b:>5} s budget {:8.2} s  relMSE {:.5}",
+                        p.name, r.seconds, r.relmse
+                    ),
+                    Err(e) => println!("{:<14} {b:>5} s budget  did not run: {e}", p.name),
+                }
+                col.cells.push(r);
             }
         }
-        Ok::<Vec<Rung>, String>(rungs)
-    };
-    // The path tracer sets the target: its 256-spp image's error.
-    let path_rungs = ladder("path", Method::Path, &[64, 128, 256], None)?;
-    let target = path_rungs.last().map_or(f64::NAN, |r| r.relmse);
-    let path_time = path_rungs.last().map_or(f64::NAN, |r| r.seconds);
-    println!("target: relMSE {target:.5} (path, 256 spp, {path_time:.2} s)");
-    table.push(("path".into(), path_rungs));
-    let stop = Some(target);
-    table.push((
-        "path+splat".into(),
-        ladder(
-            "path+splat",
-            Method::PathSplat,
-            &[4, 8, 16, 32, 64, 128],
-            stop,
-        )?,
-    ));
-    table.push((
-        "final-gather".into(),
-        ladder("final-gather", Method::FinalGather, &[1, 2, 4, 8, 16], stop)?,
-    ));
-    // The global map shown directly: its bias stays at any budget (which is why `estimate`
-    // defaults to final gathering).
-    table.push((
-        "global-direct".into(),
-        ladder("global-direct", Method::GlobalDirect, &[1, 4, 16], stop)?,
-    ));
-    // SPPM: one run, its snapshots are the ladder.
-    let out = dir.join("sppm");
-    let (seconds, relmse) = run_one(
-        &scene,
-        Method::Sppm,
-        None,
-        Some(64),
-        &out,
-        Some(&reference),
-        &cache,
-    )?;
-    let c = corrected(halves, &out.join("image.exr"))?;
-    println!("sppm             64 passes {seconds:8.2} s  relMSE {relmse:.5}{c} (whole run)");
-    // Snapshot times count from the first pass; the run's loading and writing come on top.
-    let snaps = snapshots(&out)?;
-    let overhead = snaps
-        .last()
-        .map_or(0.0, |&(_, s, _)| (seconds - s).max(0.0));
-    let mut rungs = Vec::new();
-    for (p, s, e) in snaps {
-        let s = s + overhead;
-        let c = corrected(halves, &out.join(format!("snapshots/pass-{p:05}.exr")))?;
-        println!("sppm          {p:>5} passes {s:8.2} s  relMSE {e:.5}{c} (snapshot)");
-        rungs.push(Rung {
-            budget: format!("{p} passes"),
-            seconds: s,
-            relmse: e,
-        });
-    }
-    table.push(("sppm".into(), rungs));
-    // Peers run from anywhere: give them an absolute path.
-    let abs = std::fs::canonicalize(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    for peer in peers {
-        let exr = abs.join(format!("peer-{}.exr", peer.name));
-        let _ = std::fs::remove_file(&exr);
-        let t0 = Instant::now();
-        let status = std::process::Command::new("sh")
-            .arg("-c")
-            .arg(&peer.command)
-            .env("OUT", &exr)
-            .stdout(std::process::Stdio::null())
-            .status()
-            .map_err(|e| format!("peer {}: {e}", peer.name))?;
-        let seconds = t0.elapsed().as_secs_f64();
-        if !status.success() {
-            return Err(format!(
-                "peer {}: `{}` failed ({status})",
-                peer.name, peer.command
-            ));
-        }
-        let m = render::output::compare(&exr, &reference, None)?;
-        let c = corrected(halves, &exr)?;
         println!(
-            "{:<13} {seconds:8.2} s  relMSE {:.5}{c} (incl. start-up)",
-            peer.name, m.relmse
+            "\n{}, {}x{}: corrected relative MSE (wall seconds)\n",
+            scene.file.name, scene.camera.width, scene.camera.height
         );
-        // The comparison the path tracer is judged by: its time to the peer's error.
-        let path = table.first().map_or(&[][..], |(_, r)| r.as_slice());
-        match time_to(m.relmse, path) {
-            Some(t) => println!(
-                "{:<13} the path tracer reaches its relMSE {:.5} in {t:.2} s: {:.2}x {}'s time",
-                "",
-                m.relmse,
-                t / seconds,
-                peer.name
-            ),
-            None => println!(
-                "{:<13} the path tracer's ladder does not reach its relMSE {:.5}",
-                "", m.relmse
-            ),
-        }
-        table.push((
-            peer.name.clone(),
-            vec![Rung {
-                budget: "peer".into(),
-                seconds,
-                relmse: m.relmse,
-            }],
-        ));
-    }
-    println!(
-        "\ntime to the 256-spp path tracer's relMSE {target:.5}, and the path tracer's time over it:"
-    );
-    println!("| method | time to target (s) | path tracer's time / method's | best rung |");
-    println!("|---|---|---|---|");
-    for (name, rungs) in &table {
-        let best = rungs
-            .iter()
-            .min_by(|a, b| a.relmse.total_cmp(&b.relmse))
-            .map_or(String::new(), |r| {
-                format!("{}: {:.5} in {:.2} s", r.budget, r.relmse, r.seconds)
-            });
-        match time_to(target, rungs) {
-            Some(t) => println!("| {name} | {t:.2} | {:.2}x | {best} |", path_time / t),
-            None => println!("| {name} | not reached | - | {best} |"),
+        print!("{}", tables(budgets, &ours, &theirs));
+        println!(
+            "\nphotonflow: `render --method M --time S` on all cores, photons traced anew per run; \
+             each peer ran once untimed at the smallest budget first (calibrations, caches)."
+        );
+        for ((p, col), note) in peers.iter().zip(&theirs).zip(&notes) {
+            let failed: Vec<String> = col.cells.iter().filter_map(|c| c.clone().err()).collect();
+            let how = note.clone().unwrap_or_else(|| format!("`{}`", p.command));
+            match failed.first() {
+                Some(e) => println!("{}: {how}; – : {e}", p.name),
+                None => println!("{}: {how}", p.name),
+            }
         }
     }
     Ok(())

@@ -1,4 +1,5 @@
-//! Unit tests of the lab's helpers: region masks, distances, the peers' output parsed.
+//! Unit tests of the lab's helpers: region masks, distances, the peers' output parsed, bench
+//! accuracy's cases, peers and tables.
 
 use std::path::Path;
 
@@ -89,6 +90,128 @@ fn peer_ray_rates_are_read_from_their_lines() {
         crate::bench::peer_rate("coherent rays only\n", "coherent"),
         None
     );
+}
+
+// --- bench accuracy ------------------------------------------------------------------------
+
+mod accuracy {
+    use crate::accuracy::*;
+
+    fn rung(seconds: f64, relmse: f64) -> Rung {
+        Rung { seconds, relmse }
+    }
+
+    #[test]
+    fn time_to_interpolates_log_log_between_budgets() {
+        let rungs = [rung(2.0, 0.08), rung(8.0, 0.02), rung(32.0, 0.005)];
+        // Error falling as 1/t: 0.04 is reached at 4 s exactly.
+        assert!((time_to(0.04, &rungs).unwrap() - 4.0).abs() < 1e-9);
+        // Already reached at the first budget, and exactly at a rung.
+        assert_eq!(time_to(0.5, &rungs), Some(2.0));
+        assert!((time_to(0.02, &rungs).unwrap() - 8.0).abs() < 1e-9);
+        // Not reached at the largest budget.
+        assert_eq!(time_to(0.001, &rungs), None);
+        // A corrected error at or below zero is taken as reached at that rung.
+        assert_eq!(
+            time_to(0.01, &[rung(1.0, 0.1), rung(2.0, -0.001)]),
+            Some(2.0)
+        );
+    }
+
+    #[test]
+    fn cases_and_peers_parse_and_bad_ones_say_what_is_expected() {
+        let c = Case::parse("s.toml,a.exr,b.exr").unwrap();
+        assert_eq!(
+            (
+                c.scene.to_str(),
+                c.reference_a.to_str(),
+                c.reference_b.to_str()
+            ),
+            (Some("s.toml"), Some("a.exr"), Some("b.exr"))
+        );
+        for bad in ["s.toml", "s.toml,a.exr", "s.toml,,b.exr", "a,b,c,d"] {
+            assert!(
+                Case::parse(bad)
+                    .unwrap_err()
+                    .contains("SCENE.toml,REF_A.exr,REF_B.exr")
+            );
+        }
+        let p = Peer::parse("mine=render --out $OUT").unwrap();
+        assert_eq!(
+            (p.name.as_str(), p.command.as_str()),
+            ("mine", "render --out $OUT")
+        );
+        let p = Peer::parse("smallvcm-vcm").unwrap();
+        assert!(p.command.contains("peer.sh") && p.command.contains(" smallvcm-vcm \"$SCENE\""));
+        assert!(Peer::parse("povray").unwrap_err().contains("mitsuba"));
+        assert!(Peer::parse("=x").is_err());
+    }
+
+    #[test]
+    fn the_suite_resolves_scenes_beside_it_and_references_under_refs() {
+        let d = std::env::temp_dir().join(format!("pf-suite-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let f = d.join("suite.toml");
+        std::fs::write(
+            &f,
+            "[[case]]\nscene = \"x/s.toml\"\nreference_a = \"a.exr\"\nreference_b = \"b.exr\"\n",
+        )
+        .unwrap();
+        let cases = read_suite(&f, Some(std::path::Path::new("/refs"))).unwrap();
+        assert_eq!(cases.len(), 1);
+        assert_eq!(cases[0].scene, d.join("x/s.toml"));
+        assert_eq!(cases[0].reference_b, std::path::Path::new("/refs/b.exr"));
+        assert_eq!(
+            read_suite(&f, None).unwrap()[0].reference_a,
+            d.join("a.exr")
+        );
+        std::fs::write(&f, "[[case]]\nscene = \"s.toml\"\n").unwrap();
+        assert!(read_suite(&f, None).unwrap_err().contains("suite.toml"));
+        // The committed suite parses.
+        let committed = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../scenes/bench-accuracy.toml");
+        for c in read_suite(&committed, None).unwrap() {
+            assert!(c.scene.is_file(), "{}", c.scene.display());
+        }
+    }
+
+    #[test]
+    fn the_tables_give_the_best_of_each_side_and_the_time_ratio() {
+        let col = |name: &str, cells: Vec<Result<Rung, String>>| Column {
+            name: name.into(),
+            cells,
+        };
+        let ours = [
+            col("sppm", vec![Ok(rung(2.0, 0.08)), Ok(rung(8.0, 0.02))]),
+            col("path", vec![Ok(rung(2.0, 0.1)), Ok(rung(8.0, 0.03))]),
+        ];
+        let peers = [
+            col("fast", vec![Ok(rung(2.5, 0.04)), Ok(rung(8.5, 0.01))]),
+            col(
+                "gone",
+                vec![Err("no such scene".into()), Err("no such scene".into())],
+            ),
+        ];
+        let t = tables(&[2.0, 8.0], &ours, &peers);
+        let lines: Vec<&str> = t.lines().collect();
+        assert_eq!(lines[0], "| budget | sppm | path | fast | gone |");
+        assert_eq!(
+            lines[2],
+            "| 2 s | 0.08000 (2.0 s) | 0.10000 (2.0 s) | 0.04000 (2.5 s) | – |"
+        );
+        // sppm reaches the peer's 0.04 at 4 s, the peer took 2.5 s.
+        assert_eq!(
+            lines[7],
+            "| 2 s | sppm 0.08000 | fast 0.04000 | 0.50 | 1.60 (4.0 s / 2.5 s) |"
+        );
+        assert_eq!(
+            lines[8],
+            "| 8 s | sppm 0.02000 | fast 0.01000 | 0.50 | > 0.94 (not reached in 8.0 s) |"
+        );
+        // Without a peer that ran, the comparison is blank.
+        let t = tables(&[2.0], &ours[..1], &peers[1..]);
+        assert!(t.ends_with("| 2 s | sppm 0.08000 | – | – | – |\n"), "{t}");
+    }
 }
 
 // --- The benchmarks' ray files -------------------------------------------------------------

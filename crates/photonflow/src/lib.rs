@@ -75,26 +75,32 @@ enum Cmd {
         #[arg(long, default_value_t = 3)]
         runs: usize,
     },
-    /// Time each method needs to reach the error of a 256-spp path-traced image, against a
-    /// long path-traced reference (rendered once and cached, or given), in one run.
+    /// photonflow's sppm, path+splat and path and the peer renderers at fixed time budgets,
+    /// in one run, each image's relative MSE against a reference given as two independent
+    /// halves with the reference's noise taken out; per budget, the best of each side, their
+    /// error ratio and photonflow's time to the best peer's error over the peer's time.
     BenchAccuracy {
-        scene: PathBuf,
-        /// A linear RGB EXR of the same view from any renderer (else a path-traced one is
-        /// rendered once into --dir and reused).
+        /// SCENE.toml,REF_A.exr,REF_B.exr: a scene and its reference's two halves (same
+        /// budget, other seeds). Repeatable.
+        #[arg(long, value_parser = lab::accuracy::Case::parse)]
+        case: Vec<lab::accuracy::Case>,
+        /// A suite file of cases: `[[case]]` tables with `scene` (relative to the file),
+        /// `reference_a` and `reference_b` (relative to --refs, else to the file).
         #[arg(long)]
-        reference: Option<PathBuf>,
-        /// The reference's second independent half (same budget, another seed): errors
-        /// against the halves' mean, each also with the reference's noise taken out.
+        suite: Option<PathBuf>,
+        /// Where the suite's reference halves are.
         #[arg(long)]
-        reference_b: Option<PathBuf>,
-        /// Samples per pixel of the rendered reference.
-        #[arg(long, default_value_t = 4096)]
-        reference_spp: u32,
-        /// Another renderer timed in the same run: NAME=COMMAND, a shell command that writes
-        /// a linear EXR of the same view to the path in $OUT. Repeatable.
-        #[arg(long, value_parser = parse_peer)]
-        peer: Vec<(String, String)>,
-        /// Where runs, snapshots and the cached reference go.
+        refs: Option<PathBuf>,
+        /// Time budgets in seconds, comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "2,5,15,60")]
+        budgets: Vec<f64>,
+        /// A peer: NAME of the repository's peer runner (mitsuba, luxcore, cycles,
+        /// smallvcm-ppm, smallvcm-bpt, smallvcm-vcm; it reads PEERS, PEERS_VENV and BPY_VENV)
+        /// or NAME=COMMAND, a shell command writing a linear EXR of the view of the scene file
+        /// $SCENE to $OUT in about $BUDGET seconds. Repeatable.
+        #[arg(long, value_parser = lab::accuracy::Peer::parse)]
+        peer: Vec<lab::accuracy::Peer>,
+        /// Where runs and peer images go.
         #[arg(long, default_value = "out/bench/accuracy")]
         dir: PathBuf,
     },
@@ -260,16 +266,6 @@ enum Cmd {
         #[arg(long, value_parser = parse_rect)]
         mask: Option<[usize; 4]>,
     },
-}
-
-/// `NAME=COMMAND` of `--peer`.
-fn parse_peer(s: &str) -> Result<(String, String), String> {
-    match s.split_once('=') {
-        Some((name, cmd)) if !name.is_empty() && !cmd.is_empty() => {
-            Ok((name.to_string(), cmd.to_string()))
-        }
-        _ => Err(format!("`{s}`: expected NAME=COMMAND")),
-    }
 }
 
 /// Image settings shared by `render` and `estimate`.
@@ -669,25 +665,17 @@ fn run(cmd: Cmd) -> Result<(), String> {
         } => lab::bench::splat(&scene, photons, runs),
         Cmd::BenchKnn { photons, queries } => lab::bench::knn(photons, queries),
         Cmd::BenchAccuracy {
-            scene,
-            reference,
-            reference_b,
-            reference_spp,
+            mut case,
+            suite,
+            refs,
+            budgets,
             peer,
             dir,
         } => {
-            let peers: Vec<lab::accuracy::Peer> = peer
-                .into_iter()
-                .map(|(name, command)| lab::accuracy::Peer { name, command })
-                .collect();
-            lab::accuracy::accuracy(
-                &scene,
-                reference.as_deref(),
-                reference_b.as_deref(),
-                reference_spp,
-                &peers,
-                &dir,
-            )
+            if let Some(suite) = suite {
+                case.extend(lab::accuracy::read_suite(&suite, refs.as_deref())?);
+            }
+            lab::accuracy::accuracy(&case, &budgets, &peer, &dir)
         }
         Cmd::Evidence {
             scene,
