@@ -107,6 +107,8 @@ fn worksheet_runs() -> &'static WorksheetRuns {
                 let o = Overrides {
                     method: Some(Method::PathSplat),
                     spp: Some(PATH_SPLAT_SPP),
+                    // One splatting pass, of all the paths: the runs these tests measured.
+                    passes: Some(1),
                     splat_photons: Some(SPLAT_PHOTONS),
                     ..Overrides::default()
                 };

@@ -19,6 +19,8 @@
 #             them: mcguire-original at 256 x 256 (8192 spp per half) and
 #             cornell-spheres-analytic at 512 x 512 (4096 spp per half); needs OUTDIR (they
 #             are not committed)
+# SPP_WS_BENCH  spp per half of the worksheet's benchmark halves (default 4096)
+# HALVES      which halves to render (default "a b"; e.g. HALVES=b to finish an interrupted run)
 # OUTDIR      where the images go and `stats` reads them (default: this directory)
 # `stats` prints the noise figures of the halves present (the tables of README.md).
 #
@@ -66,7 +68,7 @@ render() {
   camera "$kind" "$toml" "$w" "$h" "$TMP/$name-${w}x$h.json"
   local half seed lights=() integrator=${INTEGRATOR:-path}
   [ ! -e "$TMP/$name-${w}x$h-lights.json" ] || lights=(--lights "$TMP/$name-${w}x$h-lights.json")
-  for half in a b; do
+  for half in ${HALVES:-a b}; do
     if [ $half = a ]; then seed=$SEED_A; else seed=$SEED_B; fi
     echo "== $name ${w}x$h half $half: seed $seed, $spp spp, $integrator"
     "$PY" "$HERE/mitsuba_render_rough.py" "$PEERS" "$obj" "$@" ${lights[@]+"${lights[@]}"} \
@@ -125,8 +127,8 @@ if [ "$BENCH" = 1 ]; then
   for n in "${names[@]}"; do
     case $n in
       cornell-spheres-analytic)
-        # 4096 spp in passes of 64: a pass holds as many samples as the 128 x 128 ones.
-        render $n worksheet "$S/cornell-spheres/analytic.toml" 512 512 4096 64 \
+        # In passes of 64: a pass holds as many samples as the 128 x 128 ones.
+        render $n worksheet "$S/cornell-spheres/analytic.toml" 512 512 "${SPP_WS_BENCH:-4096}" 64 \
           "$P/cornell_worksheet_box.obj" --spheres "$P/cornell_worksheet_spheres.json" ;;
       mcguire-original)
         render $n obj "$S/mcguire/original.toml" 256 256 8192 256 "$S/mcguire/CornellBox-Original.obj" ;;
