@@ -241,3 +241,58 @@ fn describe_counts_point_and_spot_lights() {
     let extra = s.light_power().x - cornell().light_power().x;
     assert!((extra - 4.0 * std::f32::consts::PI).abs() < 1e-3, "{extra}");
 }
+
+/// Knaus and Zwicker's (2011) radius sequence in closed form: the product
+/// `prod_{i=1..j} (i + alpha) / (i + 1)` is `Gamma(j + 1 + alpha) / (Gamma(1 + alpha)
+/// Gamma(j + 2))`, which tends to `j^(alpha - 1) / Gamma(1 + alpha)`. The squared factor
+/// times `j^(1 - alpha)` must reach `1 / Gamma(5/3) = 1.10773` at alpha = 2/3 (the O(1/j)
+/// term leaves 1e-5 at j = 10^5), pass 0 is unscaled and alpha = 1 never shrinks.
+#[test]
+fn splat_footprints_shrink_as_knaus_and_zwicker_prescribe() {
+    use crate::splat::shrink;
+    assert_eq!(shrink(2.0 / 3.0, 0), 1.0);
+    assert_eq!(shrink(1.0, 12345), 1.0);
+    // One step by hand: (1 + 1/2) / 2.
+    assert!((shrink(0.5, 1) - 0.75f32.sqrt()).abs() < 1e-7);
+    let j = 100_000u64;
+    let s = shrink(2.0 / 3.0, j) as f64;
+    let limit = s * s * (j as f64).powf(1.0 / 3.0);
+    assert!((limit - 1.107_73).abs() < 1e-4, "{limit}");
+}
+
+/// SPPM's adaptive start radius is the 128th nearest photon's distance: on a plane of photons
+/// on a grid of spacing d, `d sqrt(128 / pi)` (a disc holds pi r^2 / d^2 photons), to within
+/// the grid's granularity; clamped to `[r0 / 2, 4 r0]`.
+#[test]
+fn sppm_adaptive_radius_follows_the_photon_density() {
+    use crate::methods::sppm::adaptive_radius;
+    use density::{IndexKind, PhotonMap};
+    let d = 0.01f32;
+    let photons: Vec<store::Photon> = (0..200 * 200)
+        .map(|i| {
+            let p = glam::Vec3::new((i % 200) as f32 * d, (i / 200) as f32 * d, 0.0);
+            store::Photon::new(p, glam::Vec3::ONE, -glam::Vec3::Z, 0)
+        })
+        .collect();
+    let map = PhotonMap::build(photons, IndexKind::KdTree);
+    let mut scratch = Vec::new();
+    let at = glam::Vec3::new(1.0, 1.0, 0.0);
+    let expect = d * (128.0 / std::f32::consts::PI).sqrt();
+    let r = adaptive_radius(&map, at, expect, &mut scratch);
+    assert!((r / expect - 1.0).abs() < 0.05, "{r} against {expect}");
+    // Denser than the global radius expects: no smaller than half of it.
+    assert_eq!(
+        adaptive_radius(&map, at, 4.0 * expect, &mut scratch),
+        2.0 * expect
+    );
+    // Sparser: no wider than four times it; off the plane, where none are near, the same.
+    assert_eq!(
+        adaptive_radius(&map, at, 0.1 * expect, &mut scratch),
+        0.4 * expect
+    );
+    let away = glam::Vec3::new(1.0, 1.0, 5.0);
+    assert_eq!(
+        adaptive_radius(&map, away, expect, &mut scratch),
+        4.0 * expect
+    );
+}

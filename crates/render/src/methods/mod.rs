@@ -11,7 +11,7 @@ mod final_gather;
 mod global_direct;
 mod path;
 mod path_splat;
-mod sppm;
+pub(crate) mod sppm;
 
 pub use sppm::start_radius;
 

@@ -51,7 +51,7 @@ const ADAPTIVE_K: usize = 128;
 /// `[r0 / 2, 4 r0]` of the global start radius `r0` (and `4 r0` where fewer are that near).
 /// The radius of a k-nearest-neighbour photon map estimate (Jensen 2001 §7.1), used once to
 /// start the progressive radius where the density is.
-fn adaptive_radius(
+pub(crate) fn adaptive_radius(
     map: &PhotonMap,
     p: glam::Vec3,
     r0: f32,
