@@ -1611,9 +1611,9 @@ fn path_splat_error_falls_as_an_unbiased_estimators_does() {
 /// SPPM's visible points split at the glass sphere (`[estimate.sppm] splits`): each Fresnel
 /// branch has its own statistics, so one pass already sees both what the glass reflects and
 /// what it refracts. Measured over the glass region after one pass (noise-corrected relative
-/// MSE, seed 1, 128 x 128): 0.069 with splits, 0.902 without (the classic one point per
-/// pixel, a random branch per pass); after 4 passes 0.018 against 0.404 (seeds 2 and 3 after
-/// one pass, with the adaptive radius at k = 32: 0.080 and 0.129).
+/// MSE, seed 1, 128 x 128): 0.067 with splits, 0.900 without (the classic one point per
+/// pixel, a random branch per pass); after 4 passes 0.018 against 0.404. Seed 2 reads 0.124
+/// with splits after one pass.
 #[test]
 fn sppm_glass_is_smooth_after_one_pass() {
     let h = worksheet_halves();
