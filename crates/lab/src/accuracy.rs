@@ -251,6 +251,29 @@ fn run_ours(
     })
 }
 
+/// Where an SPPM run's passes spent their time (`image.json`'s `time_sppm_<part>_s`), as
+/// `  [eye 0.9 s, trace 1.0 s, ...]`; nothing for other methods.
+fn profile(out: &Path) -> String {
+    let Ok(text) = std::fs::read_to_string(out.join("image.json")) else {
+        return String::new();
+    };
+    let Ok(j) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return String::new();
+    };
+    let parts: Vec<String> = ["eye", "trace", "index", "gather"]
+        .iter()
+        .filter_map(|p| {
+            let t = j[format!("time_sppm_{p}_s")].as_f64()?;
+            Some(format!("{p} {t:.2} s"))
+        })
+        .collect();
+    if parts.is_empty() {
+        String::new()
+    } else {
+        format!("  [passes: {}]", parts.join(", "))
+    }
+}
+
 /// One peer command, timed; `Err` holds the reason it did not run. `note` gets the peer's
 /// `settings:` line.
 fn run_peer(
@@ -349,8 +372,11 @@ pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> 
                 let out = case_dir.join(format!("{}-{b}s", m.name().replace('+', "-")));
                 let r = run_ours(&scene, *m, b, &out, &cache, &halves)?;
                 println!(
-                    "{:<14} {b:>5} s budget {:8.2} s  relMSE {:.5}",
-                    col.name, r.seconds, r.relmse
+                    "{:<14} {b:>5} s budget {:8.2} s  relMSE {:.5}{}",
+                    col.name,
+                    r.seconds,
+                    r.relmse,
+                    profile(&out)
                 );
                 col.cells.push(Ok(r));
             }
