@@ -606,13 +606,13 @@ fn cases() -> Vec<Case> {
             check: no_files("out"),
         },
         Case {
-            name: "bench-accuracy --peer without a command",
+            name: "bench-accuracy --peer neither built in nor with a command",
             files: good(),
             setup: vec![],
             prepare: None,
-            args: "bench-accuracy {d}/s.toml --peer bad --dir {d}/out",
+            args: "bench-accuracy --case {d}/s.toml,{d}/a.exr,{d}/b.exr --peer bad --dir {d}/out",
             code: 2,
-            words: &["--peer", "expected NAME=COMMAND"],
+            words: &["--peer", "not a built-in peer", "NAME=COMMAND"],
             check: absent("out"),
         },
         // Panics.
@@ -1301,10 +1301,14 @@ fn cases() -> Vec<Case> {
         },
         Case {
             name: "bench accuracy with a reference of the wrong size",
-            files: with(good(), "ref.exr", Input::Exr(grey(16, 8))),
+            files: with(
+                with(good(), "ref.exr", Input::Exr(grey(16, 8))),
+                "ref2.exr",
+                Input::Exr(grey(16, 8)),
+            ),
             setup: vec![],
             prepare: None,
-            args: "bench-accuracy {d}/s.toml --reference {d}/ref.exr --dir {d}/out",
+            args: "bench-accuracy --case {d}/s.toml,{d}/ref.exr,{d}/ref2.exr --budgets 1 --dir {d}/out",
             code: 1,
             words: &["ref.exr", "reference is 16x8"],
             check: absent("out"),

@@ -323,6 +323,13 @@ pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> 
     if budgets.is_empty() || budgets.iter().any(|b| !(*b > 0.0 && b.is_finite())) {
         return Err(format!("--budgets {budgets:?}: positive seconds"));
     }
+    // Every case's scene and reference halves are checked before anything is written.
+    for case in cases {
+        let scene = Scene::load(&case.scene).map_err(|e| e.to_string())?;
+        for half in [&case.reference_a, &case.reference_b] {
+            render::read_reference(&scene, half)?;
+        }
+    }
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     // Peers run from anywhere: give them absolute paths.
     let abs = std::fs::canonicalize(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
