@@ -184,12 +184,7 @@ fn point_light_in_glass_only_photons_find_the_caustic() {
     let dir = TempDir::new("point-glass");
     let scene = worksheet_with(32, 1, |f| {
         // The glass sphere's centre: the light inside it.
-        let c = f
-            .spheres
-            .iter()
-            .find(|s| s.material == "glass")
-            .expect("the glass sphere")
-            .center;
+        let c = glass_centre(f);
         f.lights.push(LightDesc::Point {
             position: c,
             intensity: [1.0, 1.0, 1.0],
@@ -263,12 +258,7 @@ fn point_light_in_glass_only_photons_find_the_caustic() {
 fn point_light_over_glass_partition() {
     let dir = TempDir::new("point-glass-partition");
     let scene = worksheet_with(32, 1, |f| {
-        let c = f
-            .spheres
-            .iter()
-            .find(|s| s.material == "glass")
-            .expect("the glass sphere")
-            .center;
+        let c = glass_centre(f);
         f.lights.push(LightDesc::Point {
             position: [c[0], c[1] + 6.0, c[2]],
             intensity: [30.0, 30.0, 30.0],
@@ -339,4 +329,13 @@ fn point_light_over_glass_partition() {
             );
         }
     }
+}
+
+/// The centre of the worksheet scene's glass sphere.
+fn glass_centre(f: &scene::SceneFile) -> [f32; 3] {
+    f.spheres
+        .iter()
+        .find(|s| s.material == "glass")
+        .expect("the glass sphere")
+        .center
 }
