@@ -25,8 +25,8 @@ use math::Frame;
 use scene::{Emitted, LightTable};
 
 /// Smallest `cos θ` about the light normal used for the angular footprint ([`emit_diff`]):
-/// grazing emission would give an unbounded solid-angle cell.
-pub const MIN_EMIT_COS: f32 = 0.05;
+/// grazing emission would give an unbounded solid-angle cell. The area light owns it.
+pub use scene::MIN_EMIT_COS;
 
 /// Smallest `|d·n|` in the transfer denominator (grazing hits blow differentials up).
 pub const MIN_TRANSFER_COS: f32 = 1e-3;
@@ -67,18 +67,15 @@ impl RayDiff {
 }
 
 /// Emit one photon with [`LightTable::emit`] and attach its differentials: the photon
-/// owns a cell of measure `1 / (N pdf)` of each sampled domain.
+/// owns a cell of measure `1 / (N pdf)` of each sampled domain, which the light it left
+/// measures ([`scene::Light::spread`]: the frame whose tangents carry the positional spread
+/// `ρ_x`, and the angular spread `ρ_ω`). For an area light `ρ_x = sqrt(A_i / (π p_i N))` and
+/// `ρ_ω = sqrt(1 / (N cos θ))`, `cos θ` clamped to [`MIN_EMIT_COS`]; the angular pair lies
+/// along two orthonormal vectors perpendicular to `d` (the frame's `s` projected off `d`,
+/// then `d × e1`).
 ///
-/// - Position: the point has area density `p_i / A_i` (light `i` chosen with probability
-///   `p_i`, then uniform on its area `A_i`), so the cell is `A_i / (p_i N)` and
-///   `ρ_x = sqrt(A_i / (π p_i N))` along the light's orthonormal tangents. For one light,
-///   or lights chosen by area (equal radiance, e.g. the Cornell quad), this is
-///   `sqrt(A / (π N))` with `A` the total light area.
-/// - Direction (cosine-weighted, pdf `cos θ / π`): cell `π / (N cos θ)`,
-///   `ρ_ω = sqrt(1 / (N cos θ))`, `cos θ` clamped to [`MIN_EMIT_COS`], along two orthonormal
-///   vectors perpendicular to `d` (the light tangent `s` projected off `d`, then `d × e1`).
-/// - `scale` is the user's smoothing parameter `s`: all four vectors are multiplied by it, so
-///   `|∂o/∂u × ∂o/∂v| = s² A/(π N)` and `|∂d/∂u × ∂d/∂v| = s² / (N cos θ)`.
+/// `scale` is the user's smoothing parameter `s`: all four vectors are multiplied by it, so
+/// for an area light `|∂o/∂u × ∂o/∂v| = s² A/(π N)` and `|∂d/∂u × ∂d/∂v| = s² / (N cos θ)`.
 ///
 /// The differential's origin and direction are the emitted ray's.
 pub fn emit_diff(
@@ -90,39 +87,11 @@ pub fn emit_diff(
     scale: f32,
 ) -> (Emitted, RayDiff) {
     let e = sampler.emit(u_light, u_pos, u_dir, photons);
-    let n = photons.max(1) as f64;
     let d = e.ray.d;
-    // Per emitter: the frame whose tangents carry the positional spread `ρ_x`, and the
-    // angular spread `ρ_ω`.
-    let (frame, rho_x, rho_w) = if let Some(l) = sampler.infinite(e.light) {
-        // A light at infinity: the origin is uniform on a disc of radius `R` facing the
-        // light, a cell of `π R² / (p_i N)`, so `ρ_x = R / sqrt(p_i N)` along the disc's
-        // tangents; the direction cell is `1 / (p_i N pdf_dir)` (zero for a directional
-        // light: its photons are parallel and their footprint stays the disc's spacing).
-        let pmf = sampler.pmf(e.light);
-        let rho_x = (sampler.scene_radius() as f64 / (pmf * n).sqrt()) as f32 * scale;
-        let cell = l.direction_cell(-d) / (pmf * n);
-        let rho_w = (cell / std::f64::consts::PI).sqrt() as f32 * scale;
-        (Frame::from_z(-d), rho_x, rho_w)
-    } else if let Some(l) = sampler.delta(e.light) {
-        // A point or spot light: no positional extent, and a direction cell of solid angle
-        // `1 / (N p_i pdf_dir)` (`4π/N` for one point light; for a spot, the cutoff cone's
-        // solid angle over its photons), `ρ_ω = sqrt(cell / π)` as for the area light.
-        let cone = match &l.spot {
-            None => 4.0 * std::f64::consts::PI,
-            Some(s) => std::f64::consts::TAU * (1.0 - (s.cutoff as f64).cos()),
-        };
-        let cell = cone / (sampler.pmf(e.light) * n);
-        let rho_w = (cell / std::f64::consts::PI).sqrt() as f32 * scale;
-        (Frame::from_z(d), 0.0, rho_w)
-    } else {
-        let frame = sampler.frame(e.light);
-        let cell = sampler.area(e.light) as f64 / (sampler.pmf(e.light) * n);
-        let rho_x = (cell / std::f64::consts::PI).sqrt() as f32 * scale;
-        let cos = d.dot(frame.n).max(MIN_EMIT_COS) as f64;
-        let rho_w = (1.0 / (n * cos)).sqrt() as f32 * scale;
-        (frame, rho_x, rho_w)
-    };
+    let spread = sampler.spread(&e, photons);
+    let frame = spread.frame;
+    let rho_x = spread.rho_x as f32 * scale;
+    let rho_w = spread.rho_w as f32 * scale;
     let (e1, e2) = perpendicular_pair(d, &frame);
     let rd = RayDiff {
         o: e.ray.o,

@@ -101,43 +101,14 @@ impl Plan {
                 specular.join(", ")
             )
         });
-        // Delta lights (pbrt-v4 §12.1, §12.2, §12.4): no ray hits them, so eye paths reach
-        // them only by next-event estimation, and a path from one through specular surfaces
-        // to a diffuse one (a caustic) only photons find. Lights at infinity that rays can
-        // hit (a sun disc, an environment) are found both ways, like emissive triangles.
-        for l in &scene.file.lights {
-            let delta = |kind: &str| {
-                format!(
-                    "{kind}: next-event estimation and photons; never hit by rays; caustics \
-                     through specular surfaces only by photons (the path tracer's caustic \
-                     layer from it is zero)"
-                )
-            };
-            let infinite = "next-event estimation with MIS against BSDF sampling, seen by \
-                            camera rays and rays that leave the scene; photons from a disc \
-                            covering the scene's bounding sphere";
-            reasons.push(match l {
-                scene::LightDesc::Point { .. } => delta("point light"),
-                scene::LightDesc::Spot { .. } => delta("spot light"),
-                scene::LightDesc::Directional {
-                    angular_radius: None,
-                    ..
-                } => {
-                    delta("directional light")
-                        + "; photons from a disc covering the scene's bounding sphere"
-                }
-                scene::LightDesc::Directional { .. } => format!("sun disc: {infinite}"),
-                scene::LightDesc::Environment {
-                    filename: Some(f), ..
-                } => format!(
-                    "environment map ({f}): importance-sampled by luminance (pbrt-v4 §12.5.2); \
-                     {infinite}"
-                ),
-                scene::LightDesc::Environment { .. } => {
-                    format!("constant environment: {infinite}")
-                }
-            });
-        }
+        // Each light says what the methods do with it (delta lights: only photons find
+        // their caustics; lights at infinity: photons from a disc).
+        reasons.extend(
+            scene
+                .light_table
+                .lights()
+                .filter_map(scene::Light::plan_line),
+        );
         let glossy = names(&|m, _| scene.bsdf(m).is_some_and(|b| b.is_glossy()));
         if !glossy.is_empty() {
             reasons.push(format!(

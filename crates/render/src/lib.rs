@@ -179,41 +179,10 @@ pub fn describe(s: &Scene) -> String {
     let _ = writeln!(o, "scene      {} ({})", s.path.display(), s.file.name);
     let _ = writeln!(o, "triangles  {}", m.len());
     let _ = writeln!(o, "spheres    {}", s.geometry.spheres().len());
-    let t = &s.light_table;
-    let deltas: Vec<_> = (s.lights.len()..t.len())
-        .filter_map(|i| t.delta(i))
-        .collect();
-    let spots = deltas.iter().filter(|d| d.spot.is_some()).count();
-    let mut points = if deltas.is_empty() {
-        String::new()
-    } else {
-        format!(", {} point and {spots} spot lights", deltas.len() - spots)
-    };
-    let infinite: Vec<_> = (s.lights.len()..t.len())
-        .filter_map(|i| t.infinite(i))
-        .collect();
-    if !infinite.is_empty() {
-        let kind = |l: &&scene::InfiniteLight| match l {
-            scene::InfiniteLight::Directional { .. } => 0,
-            scene::InfiniteLight::Sun { .. } => 1,
-            scene::InfiniteLight::Environment(_) => 2,
-        };
-        let n = |k| infinite.iter().filter(|l| kind(l) == k).count();
-        let _ = write!(
-            points,
-            ", {} directional, {} sun and {} environment lights (scene radius {})",
-            n(0),
-            n(1),
-            n(2),
-            t.scene_radius()
-        );
-    }
     let _ = writeln!(
         o,
-        "lights     {} emissive triangles, area {:.6}{points}, power {:?}",
-        s.lights.len(),
-        s.light_area(),
-        s.light_power().to_array()
+        "lights     {}",
+        s.light_table.summary(s.light_area(), s.light_power())
     );
     for (name, mat) in s.material_names.iter().zip(&s.materials) {
         let _ = writeln!(o, "material   {name}: {mat:?}");

@@ -18,6 +18,7 @@ mod lights;
 mod load;
 mod material;
 mod polygon;
+mod scene;
 mod texture;
 mod world;
 
@@ -28,9 +29,13 @@ pub use file::{
     CameraDesc, EmissionSource, LightDesc, MaterialDesc, MeshDesc, Method, NormalMode,
     RenderSettings, SamplerKind, SceneFile, SphereDesc,
 };
-pub use lights::{DeltaLight, Emitted, InfiniteLight, LightPoint, LightSample, LightTable, Spot};
-pub use load::{AreaLight, Scene, fnv1a64};
+pub use lights::{
+    AreaLight, Directional, Emitted, Environment, Light, LightSample, LightTable, MIN_EMIT_COS,
+    PointLight, SpotLight, Spread, Sun, TriangleLight,
+};
+pub use load::fnv1a64;
 pub use material::{ALPHA_RANGE, Material};
+pub use scene::{AlbedoMap, Scene};
 pub use texture::{Texture, srgb_to_linear};
 pub use world::{SPHERE_BIT, bsdf_of, sides_agree, surface_id};
 

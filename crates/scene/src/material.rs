@@ -2,26 +2,7 @@ use glam::Vec3;
 
 /// What a surface does with light. Plain data: the eye and photon passes turn it into BSDFs.
 ///
-/// MTL files map to materials by this table (`load.rs` applies it; the README repeats it).
-/// What photonflow cannot draw is refused with an error naming the MTL file, the material
-/// and the key; what it approximates is said in one warning line per material and key.
-///
-/// | MTL | material |
-/// |---|---|
-/// | `illum 0`, `1`, no `illum` | [`Material::Lambertian`] of `Kd` (a `Ks` is not drawn: warning) |
-/// | `illum 2` | Lambertian `Kd`, plus with `Ks > 0` a GGX lobe of reflectance `Ks`, no Fresnel, α = √(2 / (`Ns` + 2)) ([`Material::Glossy`]; `Kd + Ks > 1` in a channel scales both there: warning) |
-/// | `illum 3`, `5`, `8` | [`Material::Mirror`] of `Ks` (1 where `Ks` is absent or black); 5's Fresnel and 8's "no ray tracing" are not modelled (warning), nor a `Kd` (warning) |
-/// | `illum 4`, `6`, `7`, `9` | [`Material::Dielectric`] of index `Ni` (1.5 where `Ni` <= 1 or absent: warning) and transmittance `Tf` (1 where absent); exact Fresnel (6 and 9 ask otherwise: warning) |
-/// | `illum 10` | refused (shadow matte) |
-/// | `illum 11` | [`Material::Metal`] of `Ks` (the course's constant-reflectance metal) |
-/// | `d < 1` or `Tr > 0` | glass with illum 4, 6, 7, 9, or illum 0-2 with `Ni > 1` (the course's glass); refused on any other surface |
-/// | `Ke` | emission (`emission = "ke"`, the default) |
-/// | `Ka` | emission with `emission = "ka"` (the course's convention; a `Ke` too is refused), else the ambient colour, which a physically based renderer has no use for |
-/// | `Tf` | on glass, the transmittance: a factor on the refracted light at every crossing, each in [0, 1] (out of range: refused); warning elsewhere. Absorption inside glass has no MTL key: the scene file's `absorption` |
-/// | `map_Kd` | the diffuse albedo's texture times `Kd` (the texture alone without `Kd`), on illum 0-2 (warning elsewhere); read at the OBJ's `vt`, bilinear, repeated (`Scene::bsdf_at`); a missing or unreadable image, or texture options, refused |
-/// | `map_Ks`, `map_d` | refused |
-/// | `bump`, `map_Bump`, `map_Ns`, `refl`, `disp`, `decal` | warning: drawn without |
-/// | `Pr`, `Pm`, `Ps`, `Pc`, `Pcr`, `aniso`, `anisor`, `map_Pr`, `map_Pm` (PBR extension) | refused |
+/// MTL files map to materials by the table in `load/mtl.rs`, its one statement.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {
     Lambertian {

@@ -1,7 +1,7 @@
 //! Scene loading against the course worksheet's numbers for its scene (restated in each
 //! test), and every kind of bad input.
 
-use crate::{Material, Scene};
+use crate::{Light, Material, Scene};
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 
@@ -1374,8 +1374,9 @@ fn spot_light_power_and_photons() {
         "[[light]]\ntype = \"spot\"\nposition = [0, 0.5, 0]\nlook_at = [0.3, 0, 0]\n\
          intensity = [1, 2, 3]\ncutoff_angle = 40\nbeam_width = 15\n",
     );
-    let l = *s.light_table.delta(0).unwrap();
-    let spot = l.spot.unwrap();
+    let Some(Light::Spot(spot)) = s.light_table.light(0).cloned() else {
+        panic!("not a spot light")
+    };
     // Midpoint rule over θ in f64, with Mitsuba's falloff written out.
     let (c, b) = (40f64.to_radians(), 15f64.to_radians());
     let n = 200_000;
@@ -1465,7 +1466,7 @@ fn infinite_scene(name: &str, lights: &str, exr: Option<ExrFile>) -> (Scratch, S
 /// `∫ L dω` over the sphere of light `i` at infinity, by the midpoint rule in `(cos θ, φ)`
 /// (uniform in solid angle), f64.
 fn radiance_quadrature(s: &Scene, i: usize, n: usize) -> glam::DVec3 {
-    let l = s.light_table.infinite(i).unwrap();
+    let l = s.light_table.light(i).unwrap();
     let mut sum = glam::DVec3::ZERO;
     for a in 0..n {
         let z = 1.0 - 2.0 * (a as f64 + 0.5) / n as f64;
@@ -1551,7 +1552,7 @@ fn infinite_light_power_and_photons() {
         );
         let integral = if integral == DVec3::ZERO {
             let q = radiance_quadrature(&s, 0, 1000);
-            let int = s.light_table.infinite(0).unwrap().integral();
+            let int = s.light_table.light(0).unwrap().integral();
             let rel = ((q - int) / int).abs().max_element();
             eprintln!("{what}: ∫ L dω {int}, quadrature {q}: {rel:.1e}");
             assert!(rel < 1e-4, "{what}: {int} against quadrature {q}");

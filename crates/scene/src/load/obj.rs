@@ -1,0 +1,400 @@
+//! OBJ meshes: the file read whole (its MTL files through `mtl.rs`), each face
+//! triangulated here (`polygon.rs`), vertices and normals put through the mesh's transform,
+//! texture coordinates kept, every problem named with its file and line.
+
+use super::Builder;
+use super::mtl::{convert_mtl, grey_colours};
+use super::transform::transform;
+use super::{MAX_COORD, read_regular};
+use crate::file::{MeshDesc, NormalMode};
+use crate::{EmissionSource, SceneError};
+use geom::{TriMesh, smooth_vertex_normals};
+use glam::{DMat3, DMat4, DVec3, Vec2};
+use std::cell::RefCell;
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+
+/// An OBJ file as tobj read it, with what its MTL files told.
+struct Parsed {
+    bytes: Vec<u8>,
+    models: Vec<tobj::Model>,
+    materials: Vec<tobj::Material>,
+    /// The `mtllib` names read, in order.
+    mtl_files: Vec<String>,
+    /// Which MTL file defines which materials: problems name the file at fault.
+    defined_in: Vec<(PathBuf, Vec<String>)>,
+}
+
+/// Makes a problem with the OBJ file into its error (naming the file and the scene).
+type ObjErr<'e> = &'e dyn Fn(String) -> SceneError;
+
+impl Builder<'_> {
+    /// Mesh `index` of the scene file: read, its materials added, its faces appended.
+    pub(super) fn load_mesh(&mut self, index: usize, desc: &MeshDesc) -> Result<(), SceneError> {
+        let obj_path = self.dir.join(&desc.obj);
+        // Every problem below names the file at fault and, after it, the scene that uses it.
+        let of = format!("mesh {index} of {}", self.scene_path.display());
+        let oerr = |problem: String| SceneError::new(&obj_path, format!("{problem} ({of})"));
+        let parsed = self.parse_obj(index, &obj_path, &of, &oerr)?;
+        let mat_ids = self.mtl_materials(&parsed, &obj_path, desc.emission)?;
+        self.validate_materials().map_err(|e| oerr(e.problem))?;
+        check_faces(&parsed, &oerr)?;
+        let xf = transform(desc).ok_or_else(|| {
+            self.err(format!(
+                "mesh {index} ({}): transform must be finite with a non-zero scale",
+                desc.obj
+            ))
+        })?;
+        for model in &parsed.models {
+            self.append_model(model, desc, xf, &mat_ids, &obj_path, &oerr)?;
+        }
+        Ok(())
+    }
+
+    /// Reads the OBJ file and the MTL files it names (each through [`grey_colours`]).
+    fn parse_obj(
+        &mut self,
+        index: usize,
+        obj_path: &Path,
+        of: &str,
+        oerr: ObjErr,
+    ) -> Result<Parsed, SceneError> {
+        let bytes = read_regular(obj_path).map_err(|e| {
+            SceneError::new(
+                obj_path,
+                format!(
+                    "cannot read OBJ file (mesh {index} of {}): {e}",
+                    self.scene_path.display()
+                ),
+            )
+        })?;
+        self.hash.write(&bytes);
+
+        // tobj asks for MTL files by the name in `mtllib`; read them ourselves so a missing or
+        // broken one is reported with its path.
+        let obj_dir = obj_path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let mtl_error: RefCell<Option<SceneError>> = RefCell::new(None);
+        let mtl_bytes: RefCell<Vec<u8>> = RefCell::new(Vec::new());
+        let mtl_files: RefCell<Vec<String>> = RefCell::new(Vec::new());
+        // Which MTL file defines which materials: problems name the file at fault.
+        let mtl_of: RefCell<Vec<(PathBuf, Vec<String>)>> = RefCell::new(Vec::new());
+        let loaded = tobj::load_obj_buf(
+            &mut BufReader::new(&bytes[..]),
+            // Faces come whole and are triangulated here (`polygon`): tobj's fan is wrong for
+            // non-convex faces and makes a hopeless BVH of a huge one.
+            &tobj::LoadOptions {
+                triangulate: false,
+                single_index: true,
+                ignore_points: true,
+                ignore_lines: true,
+            },
+            |p| {
+                let mtl_path = obj_dir.join(p);
+                match read_regular(&mtl_path) {
+                    Ok(b) => {
+                        mtl_bytes.borrow_mut().extend_from_slice(&b);
+                        mtl_files.borrow_mut().push(p.display().to_string());
+                        let b = match grey_colours(&b) {
+                            Ok(b) => b,
+                            Err(problem) => {
+                                *mtl_error.borrow_mut() = Some(SceneError::new(
+                                    &mtl_path,
+                                    format!("malformed MTL file: {problem} ({of})"),
+                                ));
+                                return Err(tobj::LoadError::MaterialParseError);
+                            }
+                        };
+                        tobj::load_mtl_buf(&mut BufReader::new(&b[..]))
+                            .inspect(|(mats, _)| {
+                                let names = mats.iter().map(|m| m.name.clone()).collect();
+                                mtl_of.borrow_mut().push((mtl_path.clone(), names));
+                            })
+                            .inspect_err(|e| {
+                                *mtl_error.borrow_mut() = Some(SceneError::new(
+                                    &mtl_path,
+                                    format!("malformed MTL file: {e} ({of})"),
+                                ));
+                            })
+                    }
+                    Err(e) => {
+                        *mtl_error.borrow_mut() = Some(SceneError::new(
+                            &mtl_path,
+                            format!(
+                                "cannot read MTL file named by `mtllib` in {}: {e} ({of})",
+                                obj_path.display()
+                            ),
+                        ));
+                        Err(tobj::LoadError::OpenFileFailed)
+                    }
+                }
+            },
+        );
+        if let Some(e) = mtl_error.into_inner() {
+            return Err(e);
+        }
+        self.hash.write(&mtl_bytes.into_inner());
+        let (models, materials) = loaded.map_err(|e| oerr(format!("malformed OBJ file: {e}")))?;
+        let materials =
+            materials.map_err(|e| oerr(format!("its materials failed to load: {e}")))?;
+        Ok(Parsed {
+            bytes,
+            models,
+            materials,
+            mtl_files: mtl_files.into_inner(),
+            defined_in: mtl_of.into_inner(),
+        })
+    }
+
+    /// The OBJ's MTL materials as material ids (scene-file materials of the same name win),
+    /// converted by the MTL table with their textures attached.
+    fn mtl_materials(
+        &mut self,
+        parsed: &Parsed,
+        obj_path: &Path,
+        emission: EmissionSource,
+    ) -> Result<Vec<u32>, SceneError> {
+        let mut mat_ids = Vec::with_capacity(parsed.materials.len());
+        let defined_in = &parsed.defined_in;
+        for m in &parsed.materials {
+            let id = match self.by_name.get(&m.name) {
+                Some(&id) => id,
+                None => {
+                    let mtl = defined_in
+                        .iter()
+                        .rev()
+                        .find(|(_, names)| names.contains(&m.name))
+                        .map_or(obj_path.to_path_buf(), |(p, _)| p.clone());
+                    let at = |p: String| format!("{}: material `{}`: {p}", mtl.display(), m.name);
+                    let c = convert_mtl(m, emission).map_err(|p| {
+                        SceneError::new(&mtl, format!("material `{}`: {p}", m.name))
+                    })?;
+                    self.warnings.extend(c.warnings.into_iter().map(at));
+                    let id = self.add_material(&m.name, c.material, c.emission);
+                    if let Some(t) = &c.albedo_map {
+                        let image = mtl.parent().unwrap_or(Path::new("")).join(t);
+                        let warned = self.attach_albedo_map(id, &image).map_err(|p| {
+                            SceneError::new(
+                                &mtl,
+                                format!(
+                                    "material `{}`: `map_Kd {t}`: {}: {p}",
+                                    m.name,
+                                    image.display()
+                                ),
+                            )
+                        })?;
+                        self.warnings.extend(warned.map(at));
+                    }
+                    id
+                }
+            };
+            mat_ids.push(id);
+        }
+        Ok(mat_ids)
+    }
+
+    /// One model (an `o`/`g` group) of the OBJ, its faces triangulated and transformed,
+    /// appended to the scene's mesh.
+    fn append_model(
+        &mut self,
+        model: &tobj::Model,
+        desc: &MeshDesc,
+        xf: DMat4,
+        mat_ids: &[u32],
+        obj_path: &Path,
+        oerr: ObjErr,
+    ) -> Result<(), SceneError> {
+        let nxf = DMat3::from_mat4(xf).inverse().transpose();
+        let m = &model.mesh;
+        if m.indices.is_empty() {
+            return Ok(());
+        }
+        let nv = m.positions.len() / 3;
+        let mut part = TriMesh::default();
+        for (v, &[x, y, z]) in m.positions.as_chunks::<3>().0.iter().enumerate() {
+            let p = DVec3::new(x as f64, y as f64, z as f64);
+            if !p.is_finite() {
+                return Err(oerr(format!(
+                    "object `{}`: vertex {} is not finite ({:?})",
+                    model.name,
+                    v + 1,
+                    p.to_array()
+                )));
+            }
+            let q = xf.transform_point3(p);
+            if !q.is_finite() || q.abs().max_element() > MAX_COORD {
+                return Err(oerr(format!(
+                    "object `{}`: vertex {} lies at {:?} after the mesh's transform, beyond \
+                     the {MAX_COORD:e} scene units photonflow can trace: check the scale",
+                    model.name,
+                    v + 1,
+                    q.to_array()
+                )));
+            }
+            part.positions.push(q.as_vec3());
+        }
+        let use_file_normals =
+            matches!(desc.normals, NormalMode::Auto) && m.normals.len() == 3 * nv;
+        if use_file_normals {
+            for (v, &[x, y, z]) in m.normals.as_chunks::<3>().0.iter().enumerate() {
+                let n = DVec3::new(x as f64, y as f64, z as f64);
+                let n = (nxf * n).normalize_or_zero();
+                if !n.is_finite() || n == DVec3::ZERO {
+                    return Err(oerr(format!(
+                        "object `{}`: normal {} is zero or not finite",
+                        model.name,
+                        v + 1
+                    )));
+                }
+                part.normals.push(n.as_vec3());
+            }
+        }
+        let mat = match m.material_id.map(|i| (i, mat_ids.get(i))) {
+            Some((_, Some(&id))) => id,
+            Some((i, None)) => {
+                return Err(oerr(format!(
+                    "object `{}` uses material index {i} that its MTL does not define",
+                    model.name
+                )));
+            }
+            None => {
+                return Err(oerr(format!(
+                    "object `{}` has faces before any `usemtl` line, so they have no material",
+                    model.name
+                )));
+            }
+        };
+        if m.indices.iter().any(|&i| i as usize >= nv) {
+            return Err(oerr(format!(
+                "object `{}`: face index out of range",
+                model.name
+            )));
+        }
+        // All triangles (no arities) or one arity per face.
+        let arities: Box<dyn Iterator<Item = usize>> = if m.face_arities.is_empty() {
+            Box::new(std::iter::repeat_n(3, m.indices.len() / 3))
+        } else {
+            Box::new(m.face_arities.iter().map(|&a| a as usize))
+        };
+        let mut start = 0usize;
+        let mut triangles = Vec::new();
+        for (f, n) in arities.enumerate() {
+            let Some(face) = m.indices.get(start..start.saturating_add(n)) else {
+                return Err(oerr(format!(
+                    "object `{}`: face {} runs past the index list",
+                    model.name,
+                    f + 1
+                )));
+            };
+            start += n;
+            crate::polygon::triangulate(face, &part.positions, &mut triangles)
+                .map_err(|p| oerr(format!("object `{}`, face {}: {p}", model.name, f + 1)))?;
+        }
+        if m.texcoords.len() == 2 * nv {
+            for (v, &[u, w]) in m.texcoords.as_chunks::<2>().0.iter().enumerate() {
+                if !(u.is_finite() && w.is_finite()) {
+                    return Err(oerr(format!(
+                        "object `{}`: texture coordinate {} is not finite",
+                        model.name,
+                        v + 1
+                    )));
+                }
+                part.texcoords.push(Vec2::new(u, w));
+            }
+        } else if self
+            .albedo_maps
+            .get(mat as usize)
+            .is_some_and(Option::is_some)
+        {
+            // Mitsuba 3 reads a mesh without texture coordinates at its barycentrics.
+            self.warnings.push(format!(
+                "{}: object `{}` has no texture coordinates (`vt`) for the texture of \
+                 material `{}`: read at each triangle's barycentric coordinates",
+                obj_path.display(),
+                model.name,
+                self.names.get(mat as usize).map_or("?", String::as_str)
+            ));
+        }
+        part.materials = vec![mat; triangles.len()];
+        part.indices = triangles;
+        if desc.normals == NormalMode::Smooth {
+            part.normals = smooth_vertex_normals(&part.positions, &part.indices);
+        }
+        self.mesh.append(&part);
+        Ok(())
+    }
+}
+
+/// Each way a face can lack a material has its own message (tobj reports all of them as a
+/// model without a material id); a file without faces is refused.
+fn check_faces(parsed: &Parsed, oerr: ObjErr) -> Result<(), SceneError> {
+    let Parsed {
+        bytes,
+        models,
+        materials,
+        mtl_files,
+        ..
+    } = parsed;
+    let directives = obj_directives(bytes);
+    for (line, name) in &directives.usemtl {
+        if materials.iter().any(|m| &m.name == name) {
+            continue;
+        }
+        return Err(oerr(if mtl_files.is_empty() {
+            format!(
+                "`usemtl {name}` (line {line}) names a material, but the OBJ names no MTL \
+                 file (no `mtllib` line)"
+            )
+        } else {
+            format!(
+                "`usemtl {name}` (line {line}): unknown material; {} define{} {}",
+                mtl_files.join(", "),
+                if mtl_files.len() == 1 { "s" } else { "" },
+                if materials.is_empty() {
+                    "none".to_string()
+                } else {
+                    materials
+                        .iter()
+                        .map(|m| format!("`{}`", m.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                }
+            )
+        }));
+    }
+    if models.iter().all(|m| m.mesh.indices.is_empty()) {
+        return Err(oerr(if directives.lines == 0 {
+            "the OBJ file is empty: no vertices, no faces".to_string()
+        } else {
+            "the OBJ file holds no faces (no `f` line)".to_string()
+        }));
+    }
+    Ok(())
+}
+
+/// An OBJ file's `usemtl` lines (1-based line number, material name, first use of each name)
+/// and its number of non-blank, non-comment lines, read as tobj reads them.
+struct ObjDirectives {
+    usemtl: Vec<(usize, String)>,
+    lines: usize,
+}
+
+fn obj_directives(bytes: &[u8]) -> ObjDirectives {
+    let mut d = ObjDirectives {
+        usemtl: Vec::new(),
+        lines: 0,
+    };
+    for (i, line) in String::from_utf8_lossy(bytes).lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        d.lines += 1;
+        if line.split_whitespace().next() == Some("usemtl") {
+            let name = line.split_once(' ').unwrap_or_default().1.trim();
+            if !name.is_empty() && !d.usemtl.iter().any(|(_, n)| n == name) {
+                d.usemtl.push((i + 1, name.to_string()));
+            }
+        }
+    }
+    d
+}
