@@ -168,13 +168,14 @@ enum Cmd {
     /// --reference) in image.json.
     ///
     /// path renders its samples in passes of 1, 1, 2, 4, ... samples per pixel, each at most
-    /// an eighth of the run. global-direct and final-gather trace the photon sets the scene
-    /// needs (or reuse the cached ones), estimate and composite in one go. The splatting
-    /// methods render the caustic layers: caustics seen directly (layer `caustic`) and through
-    /// further diffuse bounces (`caustic_indirect`), caustic-splat alone, path+splat added to
-    /// a path-traced image that leaves exactly those paths out; both run passes of new eye
-    /// vertices and photons. sppm takes one camera sample per pixel and pass (so it refuses
-    /// --spp), and its per-pixel radii shrink so that its error goes to zero.
+    /// an eighth of the run; its --passes N is --spp N. global-direct and final-gather trace
+    /// the photon sets the scene needs (or reuse the cached ones), estimate and composite in
+    /// one go. The splatting methods render the caustic layers: caustics seen directly (layer
+    /// `caustic`) and through further diffuse bounces (`caustic_indirect`), caustic-splat
+    /// alone, path+splat added to a path-traced image that leaves exactly those paths out;
+    /// both run passes of new eye vertices and photons. sppm takes one camera sample per pixel
+    /// and pass (so it refuses --spp), and its per-pixel radii shrink so that its error goes
+    /// to zero.
     ///
     /// Why sppm is the default: on the worksheet scene it has 6.7 to 8.4 times less error than
     /// the best peer (SmallVCM's progressive photon mapping; Mitsuba 3, LuxCore, Cycles and
