@@ -1,6 +1,7 @@
 //! The method list and defaults that README.md and `cargo xtask`'s help spell by hand are the
 //! method table's (`render::methods::METHODS`), and a scene without `render.method` renders
-//! the default they document. `cargo xtask` forwards every command of the binary.
+//! the default they document. README's command table lists every command of the binary and
+//! of `cargo xtask`, one short line each.
 
 use render::methods::{ESTIMATE_DEFAULT, METHODS};
 use scene::Method;
@@ -205,6 +206,42 @@ fn cli_commands() -> Vec<String> {
     v
 }
 
+/// The rows of README's command table (section "## Commands"), as their cells.
+fn readme_command_rows() -> Vec<Vec<String>> {
+    let readme = read("README.md");
+    let section = readme
+        .split("\n## ")
+        .find(|s| s.starts_with("Commands\n"))
+        .expect("README has no `## Commands` section");
+    section
+        .lines()
+        .filter(|l| l.starts_with("| `cargo xtask "))
+        .map(|l| {
+            l.trim_matches('|')
+                .split(" | ")
+                .map(|c| c.trim().to_string())
+                .collect()
+        })
+        .collect()
+}
+
+/// `cargo xtask render SCENE ...` is `render`; `cargo xtask bench rays ...` is `bench rays`.
+fn readme_commands() -> Vec<String> {
+    let mut v: Vec<String> = readme_command_rows()
+        .iter()
+        .map(|row| {
+            let mut words = row[0].trim_matches('`').split_whitespace().skip(2);
+            match (words.next(), words.next()) {
+                (Some("bench"), Some(what)) => format!("bench {what}"),
+                (Some(c), _) => c.to_string(),
+                (None, _) => panic!("README: an empty command in {row:?}"),
+            }
+        })
+        .collect();
+    v.sort();
+    v
+}
+
 #[test]
 fn xtask_forwards_every_command_of_the_binary() {
     let mut forwarded: Vec<String> = xtask_list("FORWARDED")
@@ -213,4 +250,25 @@ fn xtask_forwards_every_command_of_the_binary() {
         .collect();
     forwarded.sort();
     assert_eq!(forwarded, cli_commands(), "xtask/src/flags.rs's lists");
+}
+
+#[test]
+fn readme_lists_every_command_once_in_a_short_line() {
+    let mut want: Vec<String> = cli_commands()
+        .into_iter()
+        .chain(xtask_own_commands())
+        .collect();
+    want.sort();
+    assert_eq!(readme_commands(), want, "README's command table");
+    for row in readme_command_rows() {
+        assert_eq!(row.len(), 2, "README's command table: {row:?}");
+        for cell in &row {
+            assert!(
+                cell.chars().count() <= 200,
+                "README's command table: a cell of {} characters (the details belong in \
+                 the command's --help): {cell}",
+                cell.chars().count()
+            );
+        }
+    }
 }
