@@ -673,6 +673,8 @@ pub fn long_helps() -> Vec<(String, String)> {
     );
     lines
         .map(|args| {
+            // Parsing `--help` always stops with the help as its "error", as the binary
+            // prints it (`to_string` leaves out the terminal's colours).
             let text = match command().term_width(HELP_WIDTH).try_get_matches_from(&args) {
                 Ok(_) => String::new(),
                 Err(e) => e.render().to_string(),
