@@ -168,3 +168,52 @@ fn the_cpu_model_comes_from_cpuinfo() {
     );
     assert_eq!(cpu_model("processor\t: 0\n"), None);
 }
+
+/// The command lists that README's table and docs/commands.md are held to (by photonflow's
+/// tests) are the ones `parse` takes, and the help has an entry for each and for no other.
+#[test]
+fn the_command_lists_are_what_parse_takes_and_what_the_help_lists() {
+    for c in flags::FORWARDED {
+        assert!(
+            matches!(flags::parse(&strings(&[c])), Ok(Cmd::Photonflow(a)) if a == [*c]),
+            "{c}"
+        );
+    }
+    for what in flags::BENCHES {
+        assert!(
+            matches!(flags::parse(&strings(&["bench", what])), Ok(Cmd::Bench(_))),
+            "bench {what}"
+        );
+    }
+    for c in flags::OWN {
+        assert!(
+            matches!(
+                flags::parse(&strings(&[c])),
+                Ok(Cmd::GenScenes | Cmd::SlurmDemo | Cmd::Fuzz(_))
+            ),
+            "{c}"
+        );
+    }
+    let mut listed: Vec<String> = flags::FORWARDED
+        .iter()
+        .chain(flags::OWN)
+        .map(|c| c.to_string())
+        .chain(flags::BENCHES.iter().map(|w| format!("bench {w}")))
+        .collect();
+    listed.sort();
+    // An entry is a line indented by two spaces: its command, and a benchmark's name.
+    let mut entries: Vec<String> = flags::HELP
+        .lines()
+        .filter(|l| l.starts_with("  ") && !l.starts_with("   "))
+        .filter_map(|l| {
+            let mut words = l.split_whitespace();
+            match (words.next()?, words.next()) {
+                ("bench", Some("...")) => None,
+                ("bench", Some(what)) => Some(format!("bench {what}")),
+                (c, _) => Some(c.to_string()),
+            }
+        })
+        .collect();
+    entries.sort();
+    assert_eq!(entries, listed, "xtask's help against its command lists");
+}

@@ -1,6 +1,7 @@
 //! The method list and defaults that README.md and `cargo xtask`'s help spell by hand are the
 //! method table's (`render::methods::METHODS`), and a scene without `render.method` renders
-//! the default they document.
+//! the default they document. README's command table lists every command of the binary and
+//! of `cargo xtask`, one short line each.
 
 use render::methods::{ESTIMATE_DEFAULT, METHODS};
 use scene::Method;
@@ -170,4 +171,104 @@ fn estimate_without_method_runs_the_documented_default() {
         serde_json::from_str(&std::fs::read_to_string(run.join("image.json")).unwrap()).unwrap();
     let _ = std::fs::remove_dir_all(&out);
     assert_eq!(json["method"], ESTIMATE_DEFAULT.name().as_str());
+}
+
+/// The quoted names of the `pub const NAME: &[&str] = &[...];` list in `xtask/src/flags.rs`
+/// (xtask links no renderer crate, so its lists are read from the source).
+fn xtask_list(name: &str) -> Vec<String> {
+    let src = read("xtask/src/flags.rs");
+    let start = format!("pub const {name}: &[&str] = &[");
+    let at = src
+        .find(&start)
+        .unwrap_or_else(|| panic!("xtask/src/flags.rs: no `{name}` list"))
+        + start.len();
+    let end = src[at..].find("];").expect("the list's end") + at;
+    src[at..end]
+        .split('"')
+        .skip(1)
+        .step_by(2)
+        .map(str::to_string)
+        .collect()
+}
+
+/// The commands `cargo xtask` runs itself, with no photonflow command behind them.
+pub fn xtask_own_commands() -> Vec<String> {
+    xtask_list("OWN")
+}
+
+/// The binary's commands as `cargo xtask` spells them: `bench-<what>` is `bench <what>`.
+fn cli_commands() -> Vec<String> {
+    let mut v: Vec<String> = photonflow::command()
+        .get_subcommands()
+        .map(|c| c.get_name().replacen("bench-", "bench ", 1))
+        .collect();
+    v.sort();
+    v
+}
+
+/// The rows of README's command table (section "## Commands"), as their cells.
+fn readme_command_rows() -> Vec<Vec<String>> {
+    let readme = read("README.md");
+    let section = readme
+        .split("\n## ")
+        .find(|s| s.starts_with("Commands\n"))
+        .expect("README has no `## Commands` section");
+    section
+        .lines()
+        .filter(|l| l.starts_with("| `cargo xtask "))
+        .map(|l| {
+            l.trim_matches('|')
+                .split(" | ")
+                .map(|c| c.trim().to_string())
+                .collect()
+        })
+        .collect()
+}
+
+/// `cargo xtask render SCENE ...` is `render`; `cargo xtask bench rays ...` is `bench rays`.
+fn readme_commands() -> Vec<String> {
+    let mut v: Vec<String> = readme_command_rows()
+        .iter()
+        .map(|row| {
+            let mut words = row[0].trim_matches('`').split_whitespace().skip(2);
+            match (words.next(), words.next()) {
+                (Some("bench"), Some(what)) => format!("bench {what}"),
+                (Some(c), _) => c.to_string(),
+                (None, _) => panic!("README: an empty command in {row:?}"),
+            }
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn xtask_forwards_every_command_of_the_binary() {
+    let mut forwarded: Vec<String> = xtask_list("FORWARDED")
+        .into_iter()
+        .chain(xtask_list("BENCHES").iter().map(|w| format!("bench {w}")))
+        .collect();
+    forwarded.sort();
+    assert_eq!(forwarded, cli_commands(), "xtask/src/flags.rs's lists");
+}
+
+#[test]
+fn readme_lists_every_command_once_in_a_short_line() {
+    let mut want: Vec<String> = cli_commands()
+        .into_iter()
+        .chain(xtask_own_commands())
+        .collect();
+    want.sort();
+    assert_eq!(readme_commands(), want, "README's command table");
+    for row in readme_command_rows() {
+        assert_eq!(row.len(), 2, "README's command table: {row:?}");
+        for cell in &row {
+            assert!(
+                cell.chars().count() <= 200,
+                "README's command table: a cell of {} characters (the details belong in \
+                 the command's --help): {cell}",
+                cell.chars().count()
+            );
+        }
+    }
 }
