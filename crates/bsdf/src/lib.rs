@@ -129,6 +129,15 @@ impl BsdfSample {
     }
 }
 
+/// A model's Lambertian lobe ([`Bsdf::diffuse_lobe`]): its albedo, the probability with
+/// which sampling chooses it, and the rest of the model (`None` when the lobe is all of it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiffuseLobe {
+    pub albedo: Vec3,
+    pub probability: f32,
+    pub rest: Option<Bsdf>,
+}
+
 /// Every scattering model the renderer knows.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Bsdf {
@@ -242,6 +251,36 @@ impl Bsdf {
         match self {
             Bsdf::Lambertian(b) => Some(b.albedo),
             Bsdf::Glossy(b) => Some(b.albedo),
+            _ => None,
+        }
+    }
+
+    /// The model's Lambertian lobe as photon estimates split it off (Lambertian: the whole
+    /// model; Glossy: its base, chosen with its sampling probability beside the GGX lobe),
+    /// `None` for models without one. Eye and photon passes ask this rather than match on
+    /// the model, so a new model with a diffuse part is one arm here.
+    pub fn diffuse_lobe(&self) -> Option<DiffuseLobe> {
+        match self {
+            Bsdf::Lambertian(b) => Some(DiffuseLobe {
+                albedo: b.albedo,
+                probability: 1.0,
+                rest: None,
+            }),
+            Bsdf::Glossy(g) => Some(DiffuseLobe {
+                albedo: g.albedo,
+                probability: g.diffuse_probability(),
+                rest: Some(g.specular_lobe().into()),
+            }),
+            _ => None,
+        }
+    }
+
+    /// The relative index of refraction of smooth glass (a delta dielectric), `None` for every
+    /// other model: SPPM splits its visible points there by Fresnel branch, and photon
+    /// differentials refract through it.
+    pub fn glass_eta(&self) -> Option<f32> {
+        match self {
+            Bsdf::Dielectric(d) => Some(d.eta),
             _ => None,
         }
     }

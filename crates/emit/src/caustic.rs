@@ -14,7 +14,7 @@
 
 use crate::diff::{emit_diff, mesh_dn, reflect_diff, refract_diff, sphere_dn, transfer};
 use crate::{EMIT_STREAM, EmitParams};
-use bsdf::{Bsdf, Lambertian};
+use bsdf::{Bsdf, DiffuseLobe, Lambertian};
 use geom::{Hit, Prim};
 use glam::Vec3;
 use math::Rng;
@@ -187,30 +187,36 @@ fn trace_one(
             // on: light its glossy lobe sends on (L S+ G ...) is the path tracer's. So a
             // Glossy surface goes on as its Lambertian part, chosen with its sampling
             // probability (`uc` rescaled stays uniform for the roulette below).
-            let (bsdf, uc) = match bsdf {
-                Bsdf::Glossy(g) if diffuse == 1 => {
-                    let pd = g.diffuse_probability();
+            let (bsdf, uc) = match bsdf.diffuse_lobe() {
+                Some(DiffuseLobe {
+                    albedo,
+                    probability: pd,
+                    rest: Some(_),
+                }) if diffuse == 1 => {
                     if uc >= pd {
                         return;
                     }
                     flux /= pd;
-                    (Bsdf::Lambertian(Lambertian { albedo: g.albedo }), uc / pd)
+                    (Bsdf::Lambertian(Lambertian { albedo }), uc / pd)
                 }
-                b => (b, uc),
+                _ => (bsdf, uc),
             };
             // On past it as the photon tracer goes (`trace_range`): Russian roulette on the
             // albedo at a Lambertian bounce, on the sample's weight at a glossy one.
-            if let Bsdf::Lambertian(l) = bsdf {
-                let survive = (l.albedo * flux).max_element() / flux.max_element();
+            if let Some(DiffuseLobe {
+                albedo, rest: None, ..
+            }) = bsdf.diffuse_lobe()
+            {
+                let survive = (albedo * flux).max_element() / flux.max_element();
                 if uc >= survive {
                     return;
                 }
-                flux = flux * l.albedo / survive;
+                flux = flux * albedo / survive;
             }
             let Some((wi, s)) = crate::trace::scatter(&hit, bsdf, d, uc, u) else {
                 return;
             };
-            if !matches!(bsdf, Bsdf::Lambertian(_)) {
+            if !bsdf.is_diffuse() {
                 let Some(f) = crate::trace::glossy_roulette(flux, &s, &mut rng) else {
                     return;
                 };
@@ -227,11 +233,15 @@ fn trace_one(
         if diffuse == 0 {
             let (dndu, dndv) = normal_derivatives(scene, &hit, rd.dodu, rd.dodv);
             let n = hit.ns;
-            rd = match (s.is_transmission(), bsdf) {
-                (true, Bsdf::Dielectric(g)) => {
+            rd = match (s.is_transmission(), bsdf.glass_eta()) {
+                (true, Some(glass_eta)) => {
                     // Entering when the photon arrives on the shading normal's side (the
                     // dielectric's own convention).
-                    let eta = if d.dot(n) < 0.0 { 1.0 / g.eta } else { g.eta };
+                    let eta = if d.dot(n) < 0.0 {
+                        1.0 / glass_eta
+                    } else {
+                        glass_eta
+                    };
                     refract_diff(&rd, n, dndu, dndv, eta)
                         .unwrap_or_else(|| reflect_diff(&rd, n, dndu, dndv))
                 }

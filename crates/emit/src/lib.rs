@@ -1,5 +1,7 @@
-//! `emit`: photons from the scene's area lights, traced through it and stored on diffuse
-//! surfaces (Jensen 2001, "Realistic Image Synthesis Using Photon Mapping", ch. 5–6).
+//! `emit`: photons from the scene's lights (emissive triangles, point, spot, directional,
+//! sun and environment lights), traced through it and stored on diffuse surfaces (Jensen
+//! 2001, "Realistic Image Synthesis Using Photon Mapping", ch. 5–6), and caustic photons
+//! carrying photon differentials for splatting (`diff.rs`, `caustic.rs`).
 //!
 //! Key decision: **photon `i` is a pure function of `(scene seed, i)`**. Its random numbers
 //! come from [`math::Rng::for_index`] and nothing it does depends on any other photon, so
@@ -17,15 +19,20 @@
 //! [`Traced::emitted`] carries it next to the photons.
 //!
 //! Tracing rules (the whole contract, see [`trace_range`]):
-//! - emission: a light triangle chosen with probability ∝ its power (summed over RGB), a point
-//!   uniform on it, a cosine-weighted direction about its normal (one-sided); flux
-//!   `Φ_i / (p_i N)`, which is `Φ_total / N` for power-proportional choice (Jensen 2001
-//!   §5.1, multiple lights);
-//! - diffuse hit (Lambertian, albedo > 0): store, then Russian roulette with survival
-//!   `P = max(ρ·Φ) / max(Φ)` (Jensen 2001 ch. 5, Russian roulette), survivors carry
-//!   `Φ ρ / P`;
-//! - specular hit (mirror, metal, glass): sample the BSDF in `TransportMode::Importance`,
-//!   `Φ *= f |cos θ| / pdf` (glass: Fresnel-chosen reflection or refraction, weight 1);
+//! - emission (`scene::LightTable::emit`, each light type's own): a light chosen with
+//!   probability ∝ its power (summed over RGB); a triangle sends from a point uniform on it
+//!   in a cosine-weighted direction about its normal (one-sided), a point light uniformly
+//!   over the sphere, a spot uniformly in its cone weighted by its falloff, a light at
+//!   infinity from a disc covering the scene; flux `Φ_i / (p_i N)` in the mean, which is
+//!   `Φ_total / N` for power-proportional choice (Jensen 2001 §5.1, multiple lights);
+//! - diffuse hit (a diffuse lobe, albedo > 0: Lambertian, or glossy's base): store; on a
+//!   Lambertian surface Russian roulette with survival `P = max(ρ·Φ) / max(Φ)` (Jensen 2001
+//!   ch. 5, Russian roulette), survivors carry `Φ ρ / P`; a glossy one is sampled whole,
+//!   with roulette on the sample's weight;
+//! - specular hit (mirror, metal, conductor, glass): sample the BSDF in
+//!   `TransportMode::Importance`, `Φ *= f |cos θ| / pdf` (glass: Fresnel-chosen reflection
+//!   or refraction, weight 1); rough conductors and rough glass are sampled like glossy
+//!   surfaces; coloured glass scales the flux by its transmittance and absorption;
 //! - black surfaces absorb; a path ends on escape or after [`EmitParams::max_depth`] hits.
 
 mod caustic;

@@ -119,19 +119,7 @@ impl Plan {
                 glossy.join(", ")
             ));
         }
-        let tinted = names(&|_, m| match *m {
-            Material::Dielectric {
-                transmittance,
-                absorption,
-                ..
-            }
-            | Material::RoughDielectric {
-                transmittance,
-                absorption,
-                ..
-            } => transmittance != glam::Vec3::ONE || absorption != glam::Vec3::ZERO,
-            _ => false,
-        });
+        let tinted = names(&|_, m| m.is_tinted());
         if !tinted.is_empty() {
             reasons.push(format!(
                 "coloured or absorbing glass ({}): light crossing it is scaled by its \

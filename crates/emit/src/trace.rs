@@ -1,7 +1,7 @@
 //! Photon tracing: paths from the lights, stored at diffuse hits.
 
 use crate::{EmitParams, Plan};
-use bsdf::{Bsdf, Lambertian, TransportMode};
+use bsdf::{Bsdf, DiffuseLobe, TransportMode};
 use glam::Vec3;
 use math::{Frame, Rng};
 use rayon::prelude::*;
@@ -214,7 +214,10 @@ impl Tracer<'_> {
                 }
                 diffuse_bounces += 1;
             }
-            if let Bsdf::Lambertian(Lambertian { albedo }) = bsdf {
+            if let Some(DiffuseLobe {
+                albedo, rest: None, ..
+            }) = bsdf.diffuse_lobe()
+            {
                 let survive = (albedo * flux).max_element() / flux.max_element();
                 if uc >= survive {
                     return;
@@ -227,7 +230,7 @@ impl Tracer<'_> {
             if s.is_specular() {
                 flux *= s.weight();
                 specular_bounces += 1;
-            } else if !matches!(bsdf, Bsdf::Lambertian(_)) {
+            } else if !bsdf.is_diffuse() {
                 let Some(f) = glossy_roulette(flux, &s, &mut rng) else {
                     return;
                 };

@@ -5,7 +5,7 @@
 //! of them is chosen with Fresnel probability (Russian roulette), so 1-spp images through the
 //! glass sphere are not speckled.
 
-use bsdf::{Bsdf, TransportMode};
+use bsdf::TransportMode;
 use geom::{Hit, Ray};
 use glam::Vec3;
 use math::{Frame, Rng, mix64};
@@ -215,40 +215,31 @@ pub(crate) fn first_diffuse(
         // Photon estimates read diffuse lobes only. The Glossy model's two lobes are chosen
         // between with its sampling probability: its Lambertian part is a vertex, its GGX
         // part is followed as a specular bounce is (pbrt-v4's SPPM follows glossy lobes too).
-        let (bsdf, lobe) = match bsdf {
-            Bsdf::Lambertian(l) => {
-                found(Found {
-                    hit,
-                    n: facing(),
-                    albedo: l.albedo,
-                    beta: b.beta,
-                    length,
-                    wo,
-                    branch: b.branch,
-                });
-                continue;
-            }
-            Bsdf::Glossy(g) => {
-                let pd = g.diffuse_probability();
-                if u_lobe < pd {
+        let (bsdf, lobe) = match bsdf.diffuse_lobe() {
+            Some(d) => {
+                // A Lambertian model is its diffuse lobe (probability 1: `beta` unchanged).
+                if d.rest.is_none() || u_lobe < d.probability {
                     found(Found {
                         hit,
                         n: facing(),
-                        albedo: g.albedo,
-                        beta: b.beta / pd,
+                        albedo: d.albedo,
+                        beta: b.beta / d.probability,
                         length,
                         wo,
                         branch: b.branch,
                     });
                     continue;
                 }
-                (Bsdf::from(g.specular_lobe()), 1.0 / (1.0 - pd))
+                match d.rest {
+                    Some(rest) => (rest, 1.0 / (1.0 - d.probability)),
+                    None => continue,
+                }
             }
-            other => (other, 1.0),
+            None => (bsdf, 1.0),
         };
         let frame = Frame::from_z(hit.ns);
         let wo_l = frame.to_local(wo);
-        let split = matches!(bsdf, Bsdf::Dielectric(_)) && b.splits < splits;
+        let split = bsdf.glass_eta().is_some() && b.splits < splits;
         let samples = if split {
             // Both branches, weighted by what each carries (f |cos|, no pdf); the stack is
             // LIFO, so refraction goes in first and reflection is followed first.

@@ -59,15 +59,18 @@ pub struct SceneFile {
     /// Materials by name. They override MTL materials of the same name.
     #[serde(default, rename = "material")]
     pub materials: BTreeMap<String, MaterialDesc>,
-    /// Point and spot lights (`[[light]]`), beside the emissive triangles. Not written back
-    /// when empty: scenes without them keep their hashes.
+    /// Lights beside the emissive triangles (`[[light]]`: point, spot, directional with or
+    /// without a sun disc, environment). Not written back when empty: scenes without them
+    /// keep their hashes.
     #[serde(default, rename = "light", skip_serializing_if = "Vec::is_empty")]
     pub lights: Vec<LightDesc>,
-    /// Photon-tracing parameters (`[photons]`). Opaque here: the emit stage reads them
-    /// (`emit::EmitParams`, with its own unknown-key check), so this crate stays below it.
+    /// Photon-tracing parameters (`[photons]`). Opaque here: `render::settings` reads them
+    /// into `emit::EmitParams` (with its own unknown-key check), so this crate stays below
+    /// the stages.
     #[serde(default)]
     pub photons: toml::Table,
-    /// Density-estimation parameters (`[estimate]`), read by the density stage.
+    /// The photon methods' parameters (`[estimate]`: `[estimate.global]`, `[estimate.splat]`,
+    /// `[estimate.sppm]`, ...). Opaque here: `render::settings` types them per method.
     #[serde(default)]
     pub estimate: toml::Table,
 }

@@ -71,6 +71,24 @@ impl Material {
         }
     }
 
+    /// True for glass that colours or absorbs the light crossing it (a transmittance other
+    /// than 1 or an absorption other than 0).
+    pub fn is_tinted(&self) -> bool {
+        match *self {
+            Material::Dielectric {
+                transmittance,
+                absorption,
+                ..
+            }
+            | Material::RoughDielectric {
+                transmittance,
+                absorption,
+                ..
+            } => transmittance != Vec3::ONE || absorption != Vec3::ZERO,
+            _ => false,
+        }
+    }
+
     /// True for the delta (perfectly specular) materials: photons bounce off them and are
     /// never stored there; a path through them to a diffuse surface is a caustic path.
     pub fn is_specular(&self) -> bool {
