@@ -6,6 +6,8 @@ use crate::Scene;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 
+/// README.md's MTL table against its one statement, in `src/load/mtl.rs`.
+mod docs;
 /// The environment light against Mitsuba 3's `envmap`, closed forms and the chi-square test.
 mod envmap;
 /// Point, spot and infinite lights: power and photons; missing or absurd lights refused.
