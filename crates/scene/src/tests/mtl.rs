@@ -77,8 +77,9 @@ fn white_as(lines: &str, emission: &str) -> Result<(Material, Vec<String>), Stri
     }
 }
 
-/// The MTL table of `Material`'s docs, row by row: what each key draws, which approximations
-/// warn (naming the file and material) and what is refused (naming file, material and key).
+/// The MTL table (the module doc of `src/load/mtl.rs`), row by row: what each key draws,
+/// which approximations warn (naming the file and material) and what is refused (naming
+/// file, material and key).
 #[test]
 fn mtl_files_follow_the_documented_table() {
     let v = |x: f32| Vec3::splat(x);
