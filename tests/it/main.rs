@@ -24,9 +24,11 @@
 //! - `point_lights`: point and spot lights against closed forms (`ρ/π I cos θ / r²` over a
 //!   plane in the path tracer and SPPM, a spot's beam, ramp and cutoff), and a point light in
 //!   the glass sphere whose light only photons find.
-//! - `references`: every method's images of the worksheet scene against Mitsuba 3's
+//! - `references`: every method's images of the reference scenes against Mitsuba 3's
 //!   (`tests/references/`, two halves), region by region, with each method's known bias and
-//!   measured noise, and negative controls that must fail.
+//!   measured noise, and negative controls that must fail; one file per scene (the worksheet,
+//!   its glass sphere close up, a glossy floor, rough spheres, coloured glass, a textured
+//!   floor, a point light's caustic, a spot-lit box, an environment map, McGuire's box).
 //! - `photons`: photon flux against the path tracer (caustic flux under the glass sphere) and
 //!   against the light power (closed furnace box).
 //! - `photon_maps`: the photon-map methods through the pipeline library, trace to image: the
