@@ -1,10 +1,10 @@
 //! The one end-to-end test binary (matklad, "Delete Cargo Integration Tests"). One module per
 //! subject:
 //!
-//! - `bad_input`: one table of broken or hostile inputs (OBJ, MTL, scene files, EXR files,
-//!   flags, photon counts, temp files), each run through the command line in process: exit
-//!   code and a one-line message naming the file and the problem, or the output a valid input
-//!   must give.
+//! - `bad_input`: tables of broken or hostile inputs, one file per kind of input (scene files,
+//!   their lights, OBJ and MTL, images, flags, photon files, shards and runs read back, temp
+//!   files), each run through the command line in process: exit code and a one-line message
+//!   naming the file and the problem, or the output a valid input must give.
 //! - `cornell`: ray casting on the worksheet scene as loaded from `scenes/` (BVH = brute force,
 //!   the light under the ceiling is reachable, camera rays behave).
 //! - `evidence`: bias^2 and variance apart from independent runs: zero bias for the path
