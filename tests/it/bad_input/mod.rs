@@ -1,4 +1,4 @@
-//! Bad input, one table: each case writes its input files into a scratch directory, runs one
+//! Bad input, in tables: each case writes its input files into a scratch directory, runs one
 //! command line through `photonflow::run_args` (the binary's own entry, in process), and
 //! checks the exit code and that the error is one line holding the given words (the file at
 //! fault and the problem). Cases that must succeed (valid scenes once refused, `Kd 0.5`) check
