@@ -1,10 +1,10 @@
 //! The one end-to-end test binary (matklad, "Delete Cargo Integration Tests"). One module per
 //! subject:
 //!
-//! - `bad_input`: one table of broken or hostile inputs (OBJ, MTL, scene files, EXR files,
-//!   flags, photon counts, temp files), each run through the command line in process: exit
-//!   code and a one-line message naming the file and the problem, or the output a valid input
-//!   must give.
+//! - `bad_input`: tables of broken or hostile inputs, one file per kind of input (scene files,
+//!   their lights, OBJ and MTL, images, flags, photon files, shards and runs read back, temp
+//!   files), each run through the command line in process: exit code and a one-line message
+//!   naming the file and the problem, or the output a valid input must give.
 //! - `cornell`: ray casting on the worksheet scene as loaded from `scenes/` (BVH = brute force,
 //!   the light under the ceiling is reachable, camera rays behave).
 //! - `evidence`: bias^2 and variance apart from independent runs: zero bias for the path
@@ -24,9 +24,11 @@
 //! - `point_lights`: point and spot lights against closed forms (`ρ/π I cos θ / r²` over a
 //!   plane in the path tracer and SPPM, a spot's beam, ramp and cutoff), and a point light in
 //!   the glass sphere whose light only photons find.
-//! - `references`: every method's images of the worksheet scene against Mitsuba 3's
+//! - `references`: every method's images of the reference scenes against Mitsuba 3's
 //!   (`tests/references/`, two halves), region by region, with each method's known bias and
-//!   measured noise, and negative controls that must fail.
+//!   measured noise, and negative controls that must fail; one file per scene (the worksheet,
+//!   its glass sphere close up, a glossy floor, rough spheres, coloured glass, a textured
+//!   floor, a point light's caustic, a spot-lit box, an environment map, McGuire's box).
 //! - `photons`: photon flux against the path tracer (caustic flux under the glass sphere) and
 //!   against the light power (closed furnace box).
 //! - `photon_maps`: the photon-map methods through the pipeline library, trace to image: the

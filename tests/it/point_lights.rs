@@ -253,7 +253,7 @@ fn point_light_in_glass_only_photons_find_the_caustic() {
 /// bit, so nothing the splats add is counted twice; the splatted caustic layers are what
 /// path+splat adds, and they are not empty. (Whether the splatted caustic is right in
 /// amount is checked against Mitsuba's light tracer in
-/// `references::a_point_light_caustic_matches_mitsubas_light_tracer`.)
+/// `references::point_caustic::a_point_light_caustic_matches_mitsubas_light_tracer`.)
 #[test]
 fn point_light_over_glass_partition() {
     let dir = TempDir::new("point-glass-partition");

@@ -1,7 +1,7 @@
 //! Textures through every method: a texture is read wherever the albedo is (the eye pass,
 //! photon scattering, the estimates at receivers, the splats), so a constant texture draws
 //! the image of its constant colour to the bit, in every method. Against Mitsuba, a checker
-//! floor: `references::a_textured_receiver_matches_mitsuba`.
+//! floor: `references::textured::a_textured_receiver_matches_mitsuba`.
 
 use crate::kit::{TempDir, bits, render_uncached, scene_at, sum_layers};
 use render::Overrides;

@@ -1,5 +1,12 @@
 //! Unit tests of the photon maps' helpers: the boundary correction's kernel mass, the
-//! irradiance cache of final gathering.
+//! irradiance cache of final gathering. The pass loop and the path tracer's passes have
+//! modules of their own.
+
+/// The progressive pass loop on a simulated clock: time budgets used, capped and bounded.
+mod passes;
+/// The path tracer's passes: unchanged without a budget, every power of two of samples ends
+/// one under a budget.
+mod path;
 
 use emit::{EmitParams, Plan};
 use std::path::{Path, PathBuf};

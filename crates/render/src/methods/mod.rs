@@ -9,7 +9,7 @@
 mod caustic_splat;
 mod final_gather;
 mod global_direct;
-mod path;
+pub(crate) mod path;
 mod path_splat;
 pub(crate) mod sppm;
 

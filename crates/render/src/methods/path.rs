@@ -19,7 +19,7 @@ use film::Class;
 use glam::DVec3;
 
 /// A pass holds at most this share of a run's samples.
-const MIN_PASSES: u32 = 8;
+pub(crate) const MIN_PASSES: u32 = 8;
 
 /// A path-traced image being accumulated pass by pass: per layer, f64 sums per pixel.
 pub(super) struct Progressive<'a> {
@@ -182,7 +182,7 @@ impl<'a> Progressive<'a> {
 /// to one, and no more than are left. Every pass but a last remainder is a power of two no
 /// larger than the largest one dividing `samples`, so every power of two of samples ends a
 /// pass; with `at_most` unbounded these are the passes 1, 1, 2, 4, ... up to the cap.
-fn next_pass(samples: u32, end: u32, at_most: u32) -> u32 {
+pub(crate) fn next_pass(samples: u32, end: u32, at_most: u32) -> u32 {
     let cap = end.div_ceil(MIN_PASSES).max(1).next_power_of_two();
     let aligned = if samples == 0 {
         1
@@ -195,7 +195,7 @@ fn next_pass(samples: u32, end: u32, at_most: u32) -> u32 {
 
 /// The sample ranges of a run of `spp`'s passes, in order: the blocks shards split and a
 /// merge adds in this order, as the one-machine run does.
-pub(super) fn passes(spp: u32) -> Vec<std::ops::Range<u64>> {
+pub(crate) fn passes(spp: u32) -> Vec<std::ops::Range<u64>> {
     let mut out = Vec::new();
     let mut done = 0;
     while done < spp {
@@ -272,53 +272,4 @@ impl crate::passes::Progressive for Progressive<'_> {
 
 pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
     crate::passes::run(&mut Progressive::new(run), run.settings.time, progress)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The passes before time budgets sized them: `passes` (what shards split) and every
-    /// run without `--time` must keep them, or images change.
-    fn old_passes(spp: u32) -> Vec<u32> {
-        let cap = spp.div_ceil(MIN_PASSES).max(1).next_power_of_two();
-        let (mut out, mut done) = (Vec::new(), 0);
-        while done < spp {
-            let n = done.clamp(1, cap).min(spp - done);
-            out.push(n);
-            done += n;
-        }
-        out
-    }
-
-    #[test]
-    fn passes_without_a_budget_are_unchanged() {
-        for spp in (1..=600).chain([1000, 4096, 4097, 65535, 1 << 24]) {
-            let new: Vec<u32> = passes(spp)
-                .iter()
-                .map(|r| (r.end - r.start) as u32)
-                .collect();
-            assert_eq!(new, old_passes(spp), "spp {spp}");
-        }
-    }
-
-    #[test]
-    fn budget_sized_passes_end_at_every_power_of_two() {
-        // A budget allowing 5, then 40, then 3 samples a pass, in a run to render.spp's
-        // bound: passes are powers of two within it, and every power of two of samples ends
-        // one.
-        let end = Knob::RenderSpp.max();
-        let mut done = 0;
-        let mut ends = Vec::new();
-        for at_most in [5; 6].into_iter().chain([40; 8]).chain([3; 8]) {
-            let n = next_pass(done, end, at_most);
-            assert!(n.is_power_of_two() && n <= at_most, "{n} at {done}");
-            done += n;
-            ends.push(done);
-        }
-        assert_eq!(ends[..6], [1, 2, 4, 8, 12, 16]);
-        for p in (0..).map(|i| 1u32 << i).take_while(|&p| p <= done) {
-            assert!(ends.contains(&p), "{p} samples end no pass: {ends:?}");
-        }
-    }
 }

@@ -1,0 +1,300 @@
+//! OBJ and MTL files at fault: malformed colours, faces of 200k and 400k vertices, a mesh
+//! that is a FIFO or scaled past the scene's range, messages naming the line, valid scenes.
+
+use super::*;
+
+/// A polygon face of `n` vertices on a unit circle around the floor's centre (x, z), written
+/// with 7 decimals; `notch` pulls one vertex to the centre (non-convex).
+fn polygon_obj(n: usize, notch: bool) -> String {
+    let mut o = String::from(OBJ);
+    o += "o disc\nusemtl white\n";
+    for i in 0..n {
+        let t = std::f64::consts::TAU * i as f64 / n as f64;
+        let (x, z) = if notch && i == n / 2 {
+            (0.0, 0.0)
+        } else {
+            (t.cos(), -t.sin())
+        };
+        o += &format!("v {x:.7} 0.001 {z:.7}\n");
+    }
+    o += "f";
+    for i in 0..n {
+        o += &format!(" {}", i + 9);
+    }
+    o + "\n"
+}
+
+/// A polygon face of `n` vertices (a multiple of 4) along the edges of a square around the
+/// floor's centre, `n / 4` per edge from its corner: between four corners, runs of collinear
+/// vertices (the sides are x or z = +-0.5 exactly).
+fn square_edges_obj(n: usize) -> String {
+    let q = n / 4;
+    let mut o = String::from(OBJ);
+    o += "o square\nusemtl white\n";
+    let t = |i: usize| -0.5 + i as f64 / q as f64;
+    for side in 0..4 {
+        for i in 0..q {
+            let (x, z) = match side {
+                0 => (t(i), 0.5),
+                1 => (0.5, -t(i)),
+                2 => (-t(i), -0.5),
+                _ => (-0.5, t(i)),
+            };
+            o += &format!("v {x:.7} 0.001 {z:.7}\n");
+        }
+    }
+    o += "f";
+    for i in 0..4 * q {
+        o += &format!(" {}", i + 9);
+    }
+    o + "\n"
+}
+
+/// The case's `s.toml` loads into `n` triangles: the work its loader did.
+fn triangles(n: usize) -> Option<Check> {
+    Some(Box::new(move |d: &Path| {
+        let s = scene::Scene::load(d.join("s.toml")).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(s.geometry.mesh().len(), n, "triangles of s.toml");
+    }))
+}
+
+fn cases() -> Vec<Case> {
+    let black = MTL.replace("Kd 0.5 0.5 0.5", "Kd 0 0 0");
+    let mirror = MTL.replace("Kd 0.5 0.5 0.5", "illum 3\nKs 0.9 0.9 0.9");
+    vec![
+        // Coloured glass: MTL `Tf`.
+        Case {
+            name: "MTL Tf out of range on glass",
+            files: files(
+                scene(""),
+                OBJ,
+                &MTL.replace(
+                    "Kd 0.5 0.5 0.5",
+                    "Kd 0.5 0.5 0.5\nnewmtl glass\nillum 7\nNi 1.5\nTf 1.5 0.5 0.5",
+                ),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &["m.mtl", "material `glass`", "`Tf 1.5 0.5 0.5`", "[0, 1]"],
+            check: None,
+        },
+        Case {
+            name: "MTL Tf on glass is coloured glass",
+            files: files(
+                scene(""),
+                OBJ,
+                &MTL.replace(
+                    "Kd 0.5 0.5 0.5",
+                    "Kd 0.5 0.5 0.5\nnewmtl glass\nillum 7\nNi 1.5\nTf 0.9 0.5 0.2",
+                ),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 0,
+            words: &[],
+            check: None,
+        },
+        // Panics.
+        Case {
+            name: "MTL colour of one number is grey",
+            files: with(
+                good(),
+                "m.mtl",
+                text(MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.5")),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 0,
+            words: &[],
+            check: None,
+        },
+        Case {
+            name: "MTL colour of two numbers",
+            files: with(
+                good(),
+                "m.mtl",
+                text(MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.5 0.5")),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &[
+                "m.mtl",
+                "line 2",
+                "`Kd` needs one number (grey) or three",
+                "s.toml",
+            ],
+            check: None,
+        },
+        Case {
+            name: "a mesh scaled to 1e19",
+            files: with(
+                files(scene("[[mesh]]\nobj = \"b.obj\"\nscale = 1e19\n"), OBJ, MTL),
+                "b.obj",
+                text("mtllib m.mtl\no big\nusemtl white\nv -1 0 -1\nv -1 0 1\nv 1 0 1\nf 1 2 3\n"),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &[
+                "b.obj",
+                "beyond the 1e15 scene units",
+                "mesh 1 of",
+                "s.toml",
+            ],
+            check: None,
+        },
+        // Hangs.
+        Case {
+            name: "a convex face of 200k vertices",
+            files: with(good(), "a.obj", text(polygon_obj(200_000, false))),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 0,
+            words: &[],
+            check: None,
+        },
+        Case {
+            name: "a non-convex face of 200k vertices",
+            files: with(good(), "a.obj", text(polygon_obj(200_000, true))),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &[
+                "a.obj",
+                "object `disc`, face 1",
+                "non-convex face of 200000",
+                "s.toml",
+            ],
+            check: None,
+        },
+        Case {
+            name: "a mesh that is a FIFO",
+            files: with(good(), "a.obj", Input::Fifo),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &["a.obj", "not a regular file", "s.toml"],
+            check: None,
+        },
+        Case {
+            name: "a face of 400k vertices along a square's edges",
+            files: with(good(), "a.obj", text(square_edges_obj(400_000))),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 0,
+            words: &[],
+            // The floor's and the light's 4, and the square's 2: its vertices inside straight
+            // edges are no corners (400k - 2 triangles, most of no area, took minutes).
+            check: triangles(6),
+        },
+        // Messages.
+        Case {
+            name: "an empty OBJ",
+            files: with(good(), "a.obj", text("")),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &["a.obj", "the OBJ file is empty", "s.toml"],
+            check: None,
+        },
+        Case {
+            name: "an OBJ without mtllib",
+            files: with(good(), "a.obj", text(OBJ.replace("mtllib m.mtl\n", ""))),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &[
+                "a.obj",
+                "`usemtl white` (line 2)",
+                "no `mtllib` line",
+                "s.toml",
+            ],
+            check: None,
+        },
+        Case {
+            name: "usemtl of an unknown material",
+            files: with(
+                good(),
+                "a.obj",
+                text(OBJ.replace("usemtl light", "usemtl lamp")),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &[
+                "a.obj",
+                "`usemtl lamp` (line 11): unknown material",
+                "m.mtl defines `white`, `light`",
+                "s.toml",
+            ],
+            check: None,
+        },
+        Case {
+            name: "faces before any usemtl",
+            files: with(good(), "a.obj", text(OBJ.replace("usemtl white\n", ""))),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &[
+                "a.obj",
+                "object `floor` has faces before any `usemtl` line",
+                "s.toml",
+            ],
+            check: None,
+        },
+        // Valid scenes refused.
+        Case {
+            name: "all surfaces black, final gathering",
+            files: files(scene(""), OBJ, &black),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method final-gather --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 0,
+            words: &[],
+            check: present("out/plan.txt", "no surface is diffuse"),
+        },
+        Case {
+            name: "only mirrors, final gathering",
+            files: files(scene(""), OBJ, &mirror),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method final-gather --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 0,
+            words: &[],
+            check: present(
+                "out/plan.txt",
+                "only emitters, seen directly or through specular",
+            ),
+        },
+        Case {
+            name: "only mirrors, sppm",
+            files: files(scene(""), OBJ, &mirror),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method sppm --photons 2000 --out {d}/out",
+            code: 0,
+            words: &[],
+            check: present("out/plan.txt", "no surface is diffuse"),
+        },
+    ]
+}
+
+#[test]
+fn bad_input_table() {
+    run_table("obj-mtl", cases());
+}

@@ -1,0 +1,234 @@
+//! The scene file at fault: missing, a FIFO or malformed, and its keys out of range
+//! (`[estimate]`, `[photons]`, glass materials), each named alone.
+
+use super::*;
+
+fn cases() -> Vec<Case> {
+    let global = |extra: &str| scene(&format!("[estimate.global]\n{extra}\n"));
+    vec![
+        // Coloured and absorbing glass: the scene file's keys.
+        Case {
+            name: "a negative absorption on glass",
+            files: files(
+                scene(
+                    "[material.glass]\ntype = \"dielectric\"\nior = 1.5\nabsorption = [0.1, -1, 0]\n",
+                ),
+                OBJ,
+                MTL,
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &[
+                "s.toml",
+                "material `glass`",
+                "absorption",
+                "finite and >= 0",
+            ],
+            check: None,
+        },
+        Case {
+            name: "a NaN absorption on rough glass",
+            files: files(
+                scene(
+                    "[material.frost]\ntype = \"rough_dielectric\"\nior = 1.5\nalpha = 0.2\nabsorption = [nan, 0, 0]\n",
+                ),
+                OBJ,
+                MTL,
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &["s.toml", "material `frost`", "absorption"],
+            check: None,
+        },
+        Case {
+            name: "a glass transmittance above 1",
+            files: files(
+                scene(
+                    "[material.glass]\ntype = \"dielectric\"\nior = 1.5\ntransmittance = [1.2, 0.5, 0.5]\n",
+                ),
+                OBJ,
+                MTL,
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &["s.toml", "material `glass`", "transmittance", "[0, 1]"],
+            check: None,
+        },
+        // The scene file itself.
+        Case {
+            name: "info on a missing scene",
+            files: vec![],
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/none.toml",
+            code: 1,
+            words: &["none.toml", "cannot read scene file"],
+            check: None,
+        },
+        // Hangs.
+        Case {
+            name: "a scene file that is a FIFO",
+            files: vec![("s.toml", Input::Fifo)],
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml",
+            code: 1,
+            words: &["s.toml", "not a regular file"],
+            check: None,
+        },
+        Case {
+            name: "sppm photons per pass beyond what one pass can map",
+            files: files(
+                scene("[estimate.sppm]\nphotons = 1000000000000\n"),
+                OBJ,
+                MTL,
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method sppm --passes 1 --threads 1 --out {d}/out",
+            code: 1,
+            words: &[
+                "s.toml: estimate.sppm.photons = 1000000000000 must be at most 4294967294 \
+                 photon paths per pass",
+            ],
+            check: absent("out"),
+        },
+        Case {
+            name: "sppm photons per pass from [photons] beyond what one pass can map",
+            files: files(scene("[photons]\nphotons = 5000000000\n"), OBJ, MTL),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method sppm --passes 1 --threads 1 --out {d}/out",
+            code: 1,
+            words: &[
+                "s.toml: photons = 5000000000: is sppm's pass size",
+                "must be at most 4294967294",
+            ],
+            check: absent("out"),
+        },
+        // Accepted bad values.
+        Case {
+            name: "r_max negative",
+            files: files(global("r_max = -1.0"), OBJ, MTL),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method global-direct --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["s.toml", "estimate.global.r_max = -1 must be positive"],
+            check: absent("out"),
+        },
+        Case {
+            name: "r_max NaN",
+            files: files(global("r_max = nan"), OBJ, MTL),
+            setup: vec![],
+            prepare: None,
+            args: "estimate {d}/s.toml --photons 2000 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["s.toml", "r_max = NaN must be positive"],
+            check: absent("out"),
+        },
+        Case {
+            name: "sppm radius 1e30",
+            files: files(scene("[estimate.sppm]\nradius = 1e30\n"), OBJ, MTL),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method sppm --photons 2000 --passes 1 --threads 1 --out {d}/out",
+            code: 1,
+            words: &[
+                "s.toml: estimate.sppm.radius = 1000000000000000000000000000000 exceeds the \
+                 scene's bounding diagonal (3)",
+            ],
+            check: absent("out"),
+        },
+        Case {
+            name: "splat indirect_radius -1",
+            files: files(
+                scene("[estimate.splat]\nindirect_radius = -1.0\n"),
+                OBJ,
+                MTL,
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method caustic-splat --photons 2000 --threads 1 --out {d}/out",
+            code: 1,
+            words: &["s.toml: estimate.splat.indirect_radius = -1 must be finite and >= 0"],
+            check: absent("out"),
+        },
+        Case {
+            name: "splat indirect_radius NaN",
+            files: files(scene("[estimate.splat]\nindirect_radius = nan\n"), OBJ, MTL),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method caustic-splat --photons 2000 --threads 1 --out {d}/out",
+            code: 1,
+            words: &["s.toml: estimate.splat.indirect_radius = NaN must be finite and >= 0"],
+            check: absent("out"),
+        },
+        Case {
+            name: "final_gather rays = 0",
+            files: files(scene("[estimate.final_gather]\nrays = 0\n"), OBJ, MTL),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method final-gather --photons 2000 --threads 1 --cache {d}/cache --out {d}/out",
+            code: 1,
+            words: &["s.toml: estimate.final_gather.rays = 0 must be at least 1"],
+            check: absent("out"),
+        },
+        // Messages.
+        Case {
+            name: "a malformed scene file spans one line",
+            files: vec![("s.toml", text("[camera\neye = 1\n"))],
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 1,
+            words: &["s.toml", "malformed scene file", "line 1"],
+            check: None,
+        },
+        // The file's keys are named one at a time.
+        Case {
+            name: "sppm passes = 0 in the file names that key alone",
+            files: files(scene("[estimate.sppm]\npasses = 0\n"), OBJ, MTL),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method sppm --out {d}/out",
+            code: 1,
+            words: &[
+                "error: ",
+                "s.toml: estimate.sppm.passes = 0 must be in 1..=1048576",
+            ],
+            check: absent("out"),
+        },
+        Case {
+            name: "sppm alpha = 1 in the file names that key alone",
+            files: files(scene("[estimate.sppm]\nalpha = 1.0\n"), OBJ, MTL),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method sppm --out {d}/out",
+            code: 1,
+            words: &["s.toml: estimate.sppm.alpha = 1 must be in (0, 1)"],
+            check: absent("out"),
+        },
+        Case {
+            name: "splat splits = 99 in the file names that key alone",
+            files: files(scene("[estimate.splat]\nsplits = 99\n"), OBJ, MTL),
+            setup: vec![],
+            prepare: None,
+            args: "render {d}/s.toml --method caustic-splat --out {d}/out",
+            code: 1,
+            words: &["s.toml: estimate.splat.splits = 99 is absurd (at most 16)"],
+            check: absent("out"),
+        },
+    ]
+}
+
+#[test]
+fn bad_input_table() {
+    run_table("scene-file", cases());
+}
