@@ -16,7 +16,21 @@
 //! [`EnvMap::eval`] is the radiance carried along a ray that escapes the scene in direction
 //! `d` (the environment seen looking along `d`), Mitsuba's `eval` for an escaped ray.
 
-use glam::{Mat3, Vec2, Vec3};
+// A decoder of untrusted bytes (image files a scene names): no input may reach a panic, so
+// the lints that find the ways to one are errors here, as in every loader; `cargo clippy` is
+// the check.
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::indexing_slicing,
+        clippy::panic,
+        clippy::unreachable
+    )
+)]
+
+use glam::{DVec3, Mat3, Vec2, Vec3};
 use math::Distribution2D;
 use math::warp::sample_uniform_sphere;
 use std::f64::consts::PI;
@@ -89,7 +103,7 @@ impl EnvMap {
                 "texel ({}, {}) of the environment map is {}: radiance must be finite and non-negative",
                 i % width,
                 i / width,
-                texels[i]
+                texels.get(i).copied().unwrap_or_default()
             ));
         }
         if texels.iter().all(|t| *t == Vec3::ZERO) {
@@ -179,7 +193,8 @@ impl EnvMap {
                 let rows = img.height - 1;
                 let j = cell_of(p.y, rows);
                 let t = (p.y as f64 * rows as f64 - j as f64).clamp(0.0, 1.0);
-                let z = img.row_cos[j] + t * (img.row_cos[j + 1] - img.row_cos[j]);
+                let (z0, z1) = (img.cos_row(j), img.cos_row(j + 1));
+                let z = z0 + t * (z1 - z0);
                 let phi = std::f64::consts::TAU * (p.x as f64 + 0.5 / img.width as f64);
                 let r = (1.0 - z * z).max(0.0).sqrt();
                 let local = Vec3::new((phi.sin() * r) as f32, z as f32, (-phi.cos() * r) as f32);
@@ -251,9 +266,11 @@ fn patch_integrals(width: usize, height: usize, texels: &[Vec3]) -> (Vec<f64>, [
     let dphi = 2.0 * PI / width as f64;
     let dtheta = PI / (height - 1) as f64;
     let mut weights = Vec::with_capacity(width * (height - 1));
-    let mut integral = [0.0f64; 3];
-    let texel = |i: usize, j: usize| -> [f64; 3] {
-        texels[j * width + i % width].to_array().map(|c| c as f64)
+    let mut integral = DVec3::ZERO;
+    let texel = |i: usize, j: usize| -> DVec3 {
+        texels
+            .get(j * width + i % width)
+            .map_or(DVec3::ZERO, |t| t.as_dvec3())
     };
     for j in 0..height - 1 {
         let (t0, t1) = (j as f64 * dtheta, (j + 1) as f64 * dtheta);
@@ -267,19 +284,24 @@ fn patch_integrals(width: usize, height: usize, texels: &[Vec3]) -> (Vec<f64>, [
                 texel(i, j + 1),
                 texel(i + 1, j + 1),
             );
-            let mut lum = 0.0;
-            for k in 0..3 {
-                let patch = 0.5 * dphi * ((a[k] + b[k]) * upper + (c[k] + d[k]) * lower);
-                integral[k] += patch;
-                lum += LUMINANCE[k] * patch;
-            }
+            let patch = 0.5 * dphi * ((a + b) * upper + (c + d) * lower);
+            integral += patch;
+            // Summed in channel order from zero, as the scalar loop it replaces did.
+            let [l0, l1, l2] = LUMINANCE;
+            let lum = 0.0 + l0 * patch.x + l1 * patch.y + l2 * patch.z;
             weights.push(lum.max(0.0));
         }
     }
-    (weights, integral)
+    (weights, integral.to_array())
 }
 
 impl Image {
+    /// `cos θ` of node row `j` (0 past the last: no caller reaches it).
+    #[inline]
+    fn cos_row(&self, j: usize) -> f64 {
+        self.row_cos.get(j).copied().unwrap_or(0.0)
+    }
+
     /// `(u, v)` of a local direction in the patch grid: `u` shifted by half a texel.
     #[inline]
     fn patch_uv(&self, d: Vec3) -> (f32, f32) {
@@ -301,10 +323,14 @@ impl Image {
         );
         let (fx, fy) = (x - i as f32, y - j as f32);
         let i1 = (i + 1) % self.width;
-        let row = |j: usize| &self.texels[j * self.width..(j + 1) * self.width];
-        let (r0, r1) = (row(j), row(j + 1));
-        let top = r0[i] * (1.0 - fx) + r0[i1] * fx;
-        let bottom = r1[i] * (1.0 - fx) + r1[i1] * fx;
+        let at = |i: usize, j: usize| {
+            self.texels
+                .get(j * self.width + i)
+                .copied()
+                .unwrap_or(Vec3::ZERO)
+        };
+        let top = at(i, j) * (1.0 - fx) + at(i1, j) * fx;
+        let bottom = at(i, j + 1) * (1.0 - fx) + at(i1, j + 1) * fx;
         top * (1.0 - fy) + bottom * fy
     }
 
@@ -312,7 +338,7 @@ impl Image {
     /// square's area `1/(W (H-1))` per patch covers `(2π/W) (cos θ_j - cos θ_{j+1})`.
     #[inline]
     fn solid_angle_factor(&self, j: usize) -> f32 {
-        let dz = self.row_cos[j] - self.row_cos[j + 1];
+        let dz = self.cos_row(j) - self.cos_row(j + 1);
         (1.0 / (2.0 * PI * (self.height - 1) as f64 * dz)) as f32
     }
 }

@@ -2,6 +2,20 @@
 //! with repeat wrapping, the defaults of Mitsuba 3's `bitmap` texture, so its images are
 //! references for textured scenes.
 
+// A decoder of untrusted bytes (image files a scene names): no input may reach a panic, so
+// the lints that find the ways to one are errors here, as in every loader; `cargo clippy` is
+// the check.
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::indexing_slicing,
+        clippy::panic,
+        clippy::unreachable
+    )
+)]
+
 use glam::{Vec2, Vec3};
 use std::path::Path;
 
@@ -115,7 +129,12 @@ impl Texture {
         };
         let (xa, xb) = (wrap(x0, self.width), wrap(x0 + 1.0, self.width));
         let (ya, yb) = (wrap(y0, self.height), wrap(y0 + 1.0, self.height));
-        let at = |x: usize, y: usize| self.texels[y * self.width + x];
+        let at = |x: usize, y: usize| {
+            self.texels
+                .get(y * self.width + x)
+                .copied()
+                .unwrap_or(Vec3::ZERO)
+        };
         // `a + (b - a) t`: exact where neighbours are equal, so a constant texture reads its
         // value to the bit.
         let lerp = |a: Vec3, b: Vec3, t: f32| a + (b - a) * t;
