@@ -7,8 +7,14 @@
 //! keys are errors, so a typo never silently falls back to a default.
 //!
 //! Loading never panics: every problem is a [`SceneError`] naming the file and what is wrong
-//! with it. This crate reads exactly the files its scene file names (the OBJ and MTL files)
-//! and nothing else.
+//! with it. This crate reads exactly the files its scene file names (OBJ meshes, the MTL
+//! files they name, textures and environment maps) and nothing else.
+//!
+//! Rooms: `load/` turns files into a [`Scene`] (one file per format or concern), `lights/`
+//! is the closed [`Light`] type with a file per family and the [`LightTable`] over them,
+//! `scene.rs` the loaded scene, `world.rs` what passes ask of a surface, `material.rs`,
+//! `texture.rs`, `envmap.rs`, `camera.rs`, `polygon.rs` and `file.rs` (the scene file's
+//! schema) one thing each.
 
 mod camera;
 mod envmap;
