@@ -1,8 +1,12 @@
 //! [`Scene`]: a loaded scene, ready to trace, and what passes ask of it as a whole. Loading
 //! (`load/`) builds it; `world.rs` answers per surface.
 
+use crate::camera::Camera;
+use crate::file::{RenderSettings, SceneFile};
 use crate::lights::AreaLight;
-use crate::{Camera, LightTable, Material, RenderSettings, SceneFile, Texture};
+use crate::lights::LightTable;
+use crate::material::Material;
+use crate::texture::Texture;
 use bsdf::Bsdf;
 use geom::Geometry;
 use glam::{DVec3, Vec3};

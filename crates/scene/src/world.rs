@@ -3,7 +3,8 @@
 //! id a photon records for it. The eye pass and the photon pass read these, so they cannot
 //! disagree about a material.
 
-use crate::{Material, Scene};
+use crate::material::Material;
+use crate::scene::Scene;
 use bsdf::{Bsdf, Dielectric, Glossy, Lambertian, Metal, Mirror, RoughConductor, RoughDielectric};
 use geom::{Hit, Prim, Ray};
 use glam::{Vec2, Vec3};

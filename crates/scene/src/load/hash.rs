@@ -1,7 +1,9 @@
 //! The hashes that key caches and name what an image means (see [`Scene`]'s fields): FNV-1a
 //! of the files a scene names and of the parts of the scene file each depends on.
 
-use crate::{RenderSettings, SceneFile};
+use crate::file::{
+    CameraDesc, LightDesc, MaterialDesc, MeshDesc, RenderSettings, SceneFile, SphereDesc,
+};
 
 /// 64-bit FNV-1a: a stable, dependency-free content hash (not for security).
 pub(super) struct Fnv(u64);
@@ -37,20 +39,20 @@ pub(super) fn scene_hashes(file: &SceneFile, files: u64, text: &str) -> (u64, u6
         struct Inputs<'a> {
             files: u64,
             seed: u64,
-            meshes: &'a [crate::MeshDesc],
-            spheres: &'a [crate::SphereDesc],
-            materials: &'a std::collections::BTreeMap<String, crate::MaterialDesc>,
+            meshes: &'a [MeshDesc],
+            spheres: &'a [SphereDesc],
+            materials: &'a std::collections::BTreeMap<String, MaterialDesc>,
             #[serde(skip_serializing_if = "<[_]>::is_empty")]
-            lights: &'a [crate::LightDesc],
-            camera: Option<&'a crate::CameraDesc>,
+            lights: &'a [LightDesc],
+            camera: Option<&'a CameraDesc>,
             render: Option<&'a RenderSettings>,
         }
         // Mesh files count by content (`files`), not by the path that names them, so a
         // resolved scene file with absolute paths keeps its caches.
-        let meshes: Vec<crate::MeshDesc> = f
+        let meshes: Vec<MeshDesc> = f
             .meshes
             .iter()
-            .map(|m| crate::MeshDesc {
+            .map(|m| MeshDesc {
                 obj: String::new(),
                 ..m.clone()
             })

@@ -3,11 +3,13 @@
 //! the [`LightTable`] over all of them.
 
 use super::Builder;
-use crate::file::EmissionSource;
+use crate::envmap::EnvMap;
+use crate::error::SceneError;
+use crate::file::{EmissionSource, LightDesc, SceneFile};
 use crate::lights::{
     AreaLight, Directional, Environment, Light, LightTable, PointLight, Sphere, SpotLight, Sun,
 };
-use crate::{EnvMap, LightDesc, SceneError, SceneFile, Texture};
+use crate::texture::Texture;
 use glam::{DVec3, Vec3};
 use math::Frame;
 

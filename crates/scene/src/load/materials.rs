@@ -2,10 +2,13 @@
 //! checks every material passes whether it came from the scene file or an MTL file.
 
 use super::Builder;
+use crate::error::SceneError;
 use crate::file::MaterialDesc;
+use crate::file::SceneFile;
 use crate::material::ALPHA_RANGE;
+use crate::material::Material;
 use crate::scene::AlbedoMap;
-use crate::{Material, SceneError, SceneFile, Texture};
+use crate::texture::Texture;
 use glam::Vec3;
 use std::path::Path;
 

@@ -27,8 +27,13 @@ mod transform;
 
 pub use hash::fnv1a64;
 
+use crate::camera::Camera;
+use crate::error::SceneError;
+use crate::file::SceneFile;
+use crate::material::Material;
 use crate::scene::AlbedoMap;
-use crate::{Camera, Material, Scene, SceneError, SceneFile, Texture};
+use crate::scene::Scene;
+use crate::texture::Texture;
 use geom::{Geometry, Sphere, TriMesh};
 use glam::Vec3;
 use hash::Fnv;

@@ -25,8 +25,9 @@
 //! | `Pr`, `Pm`, `Ps`, `Pc`, `Pcr`, `aniso`, `anisor`, `map_Pr`, `map_Pm` (the PBR extension) | refused |
 
 use super::materials::in_unit;
+use crate::file::EmissionSource;
 use crate::material::ALPHA_RANGE;
-use crate::{EmissionSource, Material};
+use crate::material::Material;
 use glam::Vec3;
 
 /// MTL colours (`Ka`, `Kd`, `Ks`, `Ke`, `Tf`) given with one number are grey, a variant real
