@@ -192,6 +192,7 @@ const CASES: &[Case] = &[
                 Method::GlobalDirect,
                 Method::FinalGather,
                 Method::Sppm,
+                Method::Light,
             ])
         },
         check: check_degenerate,
@@ -226,6 +227,7 @@ const CASES: &[Case] = &[
                 Method::CausticSplat,
                 Method::PathSplat,
                 Method::Sppm,
+                Method::Light,
             ])
         },
         check: check_huge_power,
@@ -321,6 +323,11 @@ fn quick(method: Method) -> Overrides {
         Method::Sppm => Overrides {
             photons: Some(10_000),
             passes: Some(4),
+            ..o
+        },
+        Method::Light => Overrides {
+            photons: Some(20_000),
+            passes: Some(2),
             ..o
         },
     }

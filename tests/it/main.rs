@@ -24,6 +24,8 @@
 //! - `point_lights`: point and spot lights against closed forms (`ρ/π I cos θ / r²` over a
 //!   plane in the path tracer and SPPM, a spot's beam, ramp and cutoff), and a point light in
 //!   the glass sphere whose light only photons find.
+//! - `light_tracing`: light paths joined to the camera (`--method light`): the worksheet's
+//!   area light seen directly at its radiance.
 //! - `references`: every method's images of the reference scenes against Mitsuba 3's
 //!   (`tests/references/`, two halves), region by region, with each method's known bias and
 //!   measured noise, and negative controls that must fail; one file per scene (the worksheet,
@@ -61,6 +63,7 @@ mod glass;
 mod hard_cases;
 mod infinite_lights;
 mod kit;
+mod light_tracing;
 mod photon_maps;
 mod photons;
 mod point_lights;

@@ -4,13 +4,13 @@ pub const HELP: &str = "\
 cargo xtask <command>   (the photonflow commands build the release `photonflow` binary and run
                          it; `photonflow <command> --help` has every option and the details)
 
-  render SCENE [--method path|global-direct|final-gather|caustic-splat|path+splat|sppm]
+  render SCENE [--method path|global-direct|final-gather|caustic-splat|path+splat|sppm|light]
                [--spp N] [--passes N] [--time S] [--threads N] [--out DIR]
                       render with a progress bar; writes image.exr, image.png, layers/, image.json
                       and scene.toml (the resolved scene: renders the same image again).
                       path: the path-traced reference (--no-caustics leaves out L S+ D light);
                       the photon methods chain trace (or reuse the cache) -> estimate -> composite;
-                      sppm and the splatting methods run in passes (--passes, --time) and
+                      sppm, light and the splatting methods run in passes (--passes, --time) and
                       write snapshots at 1, 2, 4, ... passes;
                       without --method: the scene's render.method (default sppm)
   trace SCENE [--photons N] [--cache DIR] [--threads N] [--force]

@@ -23,7 +23,10 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("film", &["temps"]),
     ("store", &["math", "temps"]),
     ("eye", &["math", "geom", "scene", "bsdf", "film"]),
-    ("emit", &["math", "geom", "scene", "bsdf", "store", "flow"]),
+    (
+        "emit",
+        &["math", "geom", "scene", "bsdf", "film", "store", "flow"],
+    ),
     (
         "density",
         &["math", "geom", "scene", "bsdf", "film", "store"],

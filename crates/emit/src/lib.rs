@@ -37,12 +37,14 @@
 
 mod caustic;
 pub mod diff;
+mod light;
 mod params;
 mod plan;
 mod trace;
 
 pub use caustic::{CausticPhoton, pass_stream, trace_caustics};
 pub use diff::{RayDiff, emit_diff, mesh_dn, reflect_diff, refract_diff, sphere_dn, transfer};
+pub use light::{CameraSplat, LIGHT_STREAM, trace_to_camera};
 pub use params::EmitParams;
 pub use plan::{Plan, PlanError};
 pub use trace::{EMIT_STREAM, Traced, trace_parallel, trace_pass, trace_range};

@@ -26,6 +26,27 @@ pub struct EstimateSettings {
     pub final_gather: FinalGatherSettings,
     pub splat: SplatSettings,
     pub sppm: SppmSettings,
+    pub light: LightSettings,
+}
+
+/// `[estimate.light]`: light tracing, light paths connected to the camera.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LightSettings {
+    /// Light paths per pass (0: `[photons] photons`).
+    pub photons: u64,
+    /// Passes: pass `j` traces `photons` new paths from streams `(seed, j, i)`; the image is
+    /// their mean. A time budget sets the passes it made.
+    pub passes: u32,
+}
+
+impl Default for LightSettings {
+    fn default() -> Self {
+        LightSettings {
+            photons: 0,
+            passes: 4,
+        }
+    }
 }
 
 /// `[estimate.sppm]`: stochastic progressive photon mapping (Hachisuka and Jensen 2009;
@@ -173,6 +194,7 @@ impl Default for EstimateSettings {
             final_gather: FinalGatherSettings::default(),
             splat: SplatSettings::default(),
             sppm: SppmSettings::default(),
+            light: LightSettings::default(),
         }
     }
 }
@@ -243,6 +265,8 @@ pub enum Knob {
     SplatPasses,
     /// `[estimate.sppm] passes`.
     SppmPasses,
+    /// `[estimate.light] passes`.
+    LightPasses,
 }
 
 impl Knob {
@@ -253,6 +277,7 @@ impl Knob {
             Knob::EstimateSpp => "estimate.spp",
             Knob::SplatPasses => "estimate.splat.passes",
             Knob::SppmPasses => "estimate.sppm.passes",
+            Knob::LightPasses => "estimate.light.passes",
         }
     }
 
@@ -267,7 +292,7 @@ impl Knob {
     pub const fn max(self) -> u32 {
         match self {
             Knob::RenderSpp => 1 << 24,
-            Knob::EstimateSpp | Knob::SplatPasses | Knob::SppmPasses => 1 << 20,
+            Knob::EstimateSpp | Knob::SplatPasses | Knob::SppmPasses | Knob::LightPasses => 1 << 20,
         }
     }
 
@@ -288,6 +313,7 @@ impl Knob {
             Knob::EstimateSpp => s.estimate.spp,
             Knob::SplatPasses => s.estimate.splat.passes,
             Knob::SppmPasses => s.estimate.sppm.passes,
+            Knob::LightPasses => s.estimate.light.passes,
         }
     }
 
@@ -297,6 +323,7 @@ impl Knob {
             Knob::EstimateSpp => s.estimate.spp = v,
             Knob::SplatPasses => s.estimate.splat.passes = v,
             Knob::SppmPasses => s.estimate.sppm.passes = v,
+            Knob::LightPasses => s.estimate.light.passes = v,
         }
     }
 }
@@ -462,6 +489,7 @@ impl Settings {
             Knob::EstimateSpp,
             Knob::SplatPasses,
             Knob::SppmPasses,
+            Knob::LightPasses,
         ] {
             let v = k.get(self);
             key(k.key(), &v, k.check(v))?;
@@ -509,6 +537,12 @@ impl Settings {
             return Err(format!(
                 "estimate.splat.photons = {} is absurd (at most 2^40)",
                 sp.photons
+            ));
+        }
+        if e.light.photons > 1 << 40 {
+            return Err(format!(
+                "estimate.light.photons = {} is absurd (at most 2^40)",
+                e.light.photons
             ));
         }
         if sp.splits > 16 {

@@ -65,4 +65,53 @@ impl Camera {
     pub fn forward(&self) -> Vec3 {
         self.forward
     }
+
+    /// Where the ray from the eye to `p` crosses the film, in [`Camera::ray`]'s pixel units,
+    /// with that ray's unit direction and length; `None` when `p` is behind the eye or its
+    /// ray leaves the film. The inverse of `ray`: a light path's vertex connected to the
+    /// camera lands on this point.
+    pub fn project(&self, p: Vec3) -> Option<Projection> {
+        let to = p - self.eye;
+        let dist = to.length();
+        let z = to.dot(self.forward);
+        if !(z > 0.0 && dist.is_finite()) {
+            return None;
+        }
+        let sx = to.dot(self.right) / z / self.half_w;
+        let sy = to.dot(self.up_ortho) / z / self.half_h;
+        let x = 0.5 * (sx + 1.0) * self.width as f32;
+        let y = 0.5 * (1.0 - sy) * self.height as f32;
+        if !(x >= 0.0 && x < self.width as f32 && y >= 0.0 && y < self.height as f32) {
+            return None;
+        }
+        let dir = to / dist;
+        Some(Projection {
+            pixel: (y as u32).min(self.height - 1) * self.width + (x as u32).min(self.width - 1),
+            dir,
+            dist,
+            cos: dir.dot(self.forward),
+        })
+    }
+
+    /// The importance `W_e` of a pixel for a ray leaving the eye at `cos` to the view axis,
+    /// per unit of the ray's solid angle: `1 / (A cos^4 θ)`, `A` a pixel's area on the image
+    /// plane at distance 1 (pbrt-v4 §5.4.1's `We` for a pinhole, normalised per pixel so a
+    /// pixel's value is the mean radiance over it).
+    pub fn importance(&self, cos: f32) -> f32 {
+        let area = 4.0 * self.half_w * self.half_h / (self.width as f32 * self.height as f32);
+        1.0 / (area * (cos * cos) * (cos * cos))
+    }
+}
+
+/// A point seen by the camera ([`Camera::project`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Projection {
+    /// Index of the pixel, `y * width + x`.
+    pub pixel: u32,
+    /// Unit direction from the eye to the point.
+    pub dir: Vec3,
+    /// Distance from the eye to the point.
+    pub dist: f32,
+    /// Cosine between `dir` and the view axis.
+    pub cos: f32,
 }

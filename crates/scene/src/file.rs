@@ -149,17 +149,21 @@ pub enum Method {
     /// worksheet scene it reaches a given error first (`cargo xtask bench accuracy`).
     #[default]
     Sppm,
+    /// Light tracing: light paths connected to the camera at every non-delta vertex
+    /// (`[estimate.light]`); sharp caustics without a density estimate.
+    Light,
 }
 
 impl Method {
     /// Every method, in declaration order.
-    pub const ALL: [Method; 6] = [
+    pub const ALL: [Method; 7] = [
         Method::Path,
         Method::GlobalDirect,
         Method::FinalGather,
         Method::CausticSplat,
         Method::PathSplat,
         Method::Sppm,
+        Method::Light,
     ];
 
     /// The method's name as the scene file spells it.

@@ -28,7 +28,7 @@ mod scene;
 mod texture;
 mod world;
 
-pub use camera::Camera;
+pub use camera::{Camera, Projection};
 pub use envmap::EnvMap;
 pub use error::SceneError;
 pub use file::{

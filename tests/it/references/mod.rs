@@ -166,6 +166,17 @@ fn image_by(s: &Scene, method: Method, count: u32) -> Image {
     sum_layers(&render_uncached(s, &o, None), |_| true)
 }
 
+/// The light tracer's run of `s`: `passes` passes of `photons` paths.
+fn light_run(s: &Scene, passes: u32, photons: u64) -> render::Rendered {
+    let o = Overrides {
+        method: Some(Method::Light),
+        passes: Some(passes),
+        photons: Some(photons),
+        ..Overrides::default()
+    };
+    render_uncached(s, &o, None)
+}
+
 /// The misfits of each run's image of `s` (method, count, its table) against `regs`.
 fn misfits_of_runs<const N: usize>(
     s: &Scene,

@@ -9,6 +9,7 @@
 mod caustic_splat;
 mod final_gather;
 mod global_direct;
+mod light;
 pub(crate) mod path;
 mod path_splat;
 pub(crate) mod sppm;
@@ -33,6 +34,8 @@ pub enum Input {
     EyeVertices,
     /// SPPM's visible points, one per pixel and pass.
     VisiblePoints,
+    /// Light paths joined to the camera.
+    LightPaths,
 }
 
 /// What a method's progress bar counts, in total.
@@ -42,6 +45,8 @@ pub enum Work {
     PixelSamples(Knob),
     /// Caustic photon paths splatted: per pass x passes (`[estimate.splat]`).
     SplatPhotons,
+    /// Light paths traced to the camera: per pass x passes (`[estimate.light]`).
+    LightPhotons,
 }
 
 /// One row of the method table: everything the rest of the program asks of a method.
@@ -85,7 +90,7 @@ impl MethodRow {
 
 /// The method table: one row per `scene::Method`, in `Method::ALL`'s order. Nothing else
 /// matches on `Method`.
-pub static METHODS: [MethodRow; 6] = [
+pub static METHODS: [MethodRow; 7] = [
     MethodRow {
         method: Method::Path,
         help: "the path-traced reference: next-event estimation and BSDF sampling by MIS, in \
@@ -174,6 +179,20 @@ pub static METHODS: [MethodRow; 6] = [
              `path`, or render independent seeds and `composite` them",
         ),
     },
+    MethodRow {
+        method: Method::Light,
+        help: "light tracing: light paths joined to the camera at every non-delta vertex, in \
+               passes; sharp caustics without a density estimate, but no light seen through \
+               specular surfaces",
+        table: "[estimate.light]",
+        reads: &[Input::LightPaths],
+        spp: None,
+        passes: Some(Knob::LightPasses),
+        work: Work::LightPhotons,
+        whole_image: true,
+        render: light::render,
+        blocks: Ok(light::blocks),
+    },
 ];
 
 const PHOTON_MAP_SHARDS: &str = "the photon-map methods estimate from one photon map: shard \
@@ -251,6 +270,15 @@ pub fn work(run: &Run) -> (u64, &'static str) {
                 s.emit.photons
             };
             (per_pass.saturating_mul(sp.passes as u64), "photons")
+        }
+        Work::LightPhotons => {
+            let l = &s.estimate.light;
+            let per_pass = if l.photons > 0 {
+                l.photons
+            } else {
+                s.emit.photons
+            };
+            (per_pass.saturating_mul(l.passes as u64), "light paths")
         }
     }
 }
