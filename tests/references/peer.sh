@@ -5,7 +5,8 @@
 #   PEERS=/path/to/peers PEERS_VENV=/path/to/venv [BPY_VENV=/path/to/bpy-venv] \
 #     tests/references/peer.sh PEER SCENE.toml SECONDS OUT.exr
 #
-# PEER        mitsuba | luxcore | cycles | smallvcm-ppm | smallvcm-bpt | smallvcm-vcm
+# PEER        mitsuba | mitsuba-ptracer | luxcore | cycles | smallvcm-ppm | smallvcm-bpt |
+#             smallvcm-vcm
 # PEERS       the peers directory (mitsuba_render.py, luxcore_render.py, cycles_render.py,
 #             smallvcm/ built with its build.sh, worksheet/)
 # PEERS_VENV  the peers' virtual environment (Mitsuba 3, LuxCore, OpenEXR); or PEERS_PYTHON
@@ -21,6 +22,8 @@
 #                 Russian roulette from depth 5). It has no time limit: the spp come from a
 #                 calibration (two short untimed renders, 4 and 32 spp, cached per scene file
 #                 and size) fitting wall = start-up + spp x seconds per spp, to fill SECONDS.
+#   mitsuba-ptracer  Mitsuba 3's particle (light) tracer, calibrated the same way: it draws
+#                 no specular surface the camera sees (as photonflow's `light`).
 #   luxcore      path tracer + PhotonGI caustic cache (100k photons a second of SECONDS, 100k
 #                 to 1M; radius 0.2% of the scene's diagonal: 0.05 in the worksheet), its own
 #                 time halt, whole seconds: SECONDS + the cache build's (cached per scene, with a
@@ -55,7 +58,9 @@ only_mtl() { # the peers other than Mitsuba map only the MTL's diffuse, mirror, 
 }
 
 case $peer in
-  mitsuba)
+  mitsuba|mitsuba-ptracer)
+    integrator=path
+    [ "$peer" = mitsuba ] || integrator=ptracer
     lights=()
     [ -z "$LIGHTS" ] || lights=(--lights "$LIGHTS")
     glossy=()
@@ -63,14 +68,14 @@ case $peer in
     mi() { # SPP OUT
       "$PY" "$HERE/mitsuba_render_rough.py" "$PEERS" "$OBJ" ${spheres[@]+"${spheres[@]}"} \
         ${lights[@]+"${lights[@]}"} ${glossy[@]+"${glossy[@]}"} --camera "$TMP/camera.json" \
-        --width "$W" --height "$H" --spp "$1" --spp-per-pass 16 --seed 7 --integrator path \
+        --width "$W" --height "$H" --spp "$1" --spp-per-pass 16 --seed 7 --integrator "$integrator" \
         --max-depth -1 --rr-depth 5 --sampler independent --rfilter box --variant llvm_ad_rgb \
         -o "$2" > /dev/null
     }
     cache=${PEER_CACHE:-$(dirname "$out")/peer-cache}
     mkdir -p "$cache"
     key=$(cat "$scene" "$TMP/camera.json" | cksum | cut -d' ' -f1)
-    cal=$cache/mitsuba-$key-${W}x$H.txt
+    cal=$cache/$peer-$key-${W}x$H.txt
     if [ ! -s "$cal" ]; then
       t() { local t0; t0=$(date +%s.%N); mi "$1" "$TMP/cal.exr"; echo "$(date +%s.%N) $t0" | awk '{ print $1 - $2 }'; }
       t4=$(t 4) t32=$(t 32)
@@ -79,7 +84,7 @@ case $peer in
     read -r a b < "$cal"
     spp=$(awk -v s="$secs" -v a="$a" -v b="$b" 'BEGIN { n = int((s - a) / b); print (n < 1 ? 1 : n) }')
     mi "$spp" "$out"
-    echo "settings: Mitsuba 3 path tracer (llvm_ad_rgb, all cores), $spp spp from a cached calibration (start-up $(printf %.2f "$a") s + $(printf %.4f "$b") s/spp), independent sampler, box filter"
+    echo "settings: Mitsuba 3 $integrator (llvm_ad_rgb, all cores), $spp spp from a cached calibration (start-up $(printf %.2f "$a") s + $(printf %.4f "$b") s/spp), independent sampler, box filter"
     ;;
   luxcore)
     only_mtl
@@ -139,5 +144,5 @@ exrio.write_exr(sys.argv[5], img.reshape(h, f, w, f, 3).mean(axis=(1, 3)).astype
 EOF
     echo "settings: SmallVCM $alg${radius[1]:+ (merge radius ${radius[1]})}, -t $secs s, $THREADS threads, 512x512 box-averaged to ${W}x$H"
     ;;
-  *) echo "unknown PEER $peer (mitsuba, luxcore, cycles, smallvcm-ppm, smallvcm-bpt, smallvcm-vcm)" >&2; exit 2 ;;
+  *) echo "unknown PEER $peer (mitsuba, mitsuba-ptracer, luxcore, cycles, smallvcm-ppm, smallvcm-bpt, smallvcm-vcm)" >&2; exit 2 ;;
 esac

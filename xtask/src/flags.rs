@@ -63,14 +63,14 @@ cargo xtask <command>   (the photonflow commands build the release `photonflow` 
                       peak memory (default scene: scenes/cornell-spheres/analytic.toml)
   bench accuracy [--case SCENE.toml,REF_A.exr,REF_B.exr]... [--suite FILE] [--refs DIR]
                  [--budgets 2,5,15,60] [--peer NAME | --peer NAME=CMD]...
-                      photonflow's sppm, path+splat and path and the peers at fixed time
-                      budgets, in one run: the relative MSE of each image against the
+                      photonflow's sppm, path+splat, path and light and the peers at fixed
+                      time budgets, in one run: the relative MSE of each image against the
                       scene's two reference halves, the reference's noise taken out; per
                       budget the best of each side, the error ratio and photonflow's time to
                       the best peer's error over the peer's time. Without --case, the suite
                       scenes/bench-accuracy.toml (its references under --refs DIR). Peers:
-                      tests/references/peer.sh's mitsuba, luxcore, cycles, smallvcm-ppm,
-                      smallvcm-bpt, smallvcm-vcm (set PEERS, PEERS_VENV, BPY_VENV), or shell
+                      tests/references/peer.sh's mitsuba, mitsuba-ptracer, luxcore, cycles,
+                      smallvcm-ppm, smallvcm-bpt, smallvcm-vcm (set PEERS, PEERS_VENV, BPY_VENV), or shell
                       commands writing an EXR to $OUT (also given $SCENE, $BUDGET)
   bench knn [--photons N] [--queries N]
                       k-NN queries/s for k = 50, 250, 1000 per index (kd-tree, kiddo, brute),

@@ -11,14 +11,20 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// photonflow's methods in the table, in its column order.
-pub const METHODS: [Method; 3] = [Method::Sppm, Method::PathSplat, Method::Path];
+pub const METHODS: [Method; 4] = [
+    Method::Sppm,
+    Method::PathSplat,
+    Method::Path,
+    Method::Light,
+];
 
 /// The default budgets, in seconds.
 pub const BUDGETS: [f64; 4] = [2.0, 5.0, 15.0, 60.0];
 
 /// The peers `--peer NAME` names: `tests/references/peer.sh NAME`.
-pub const BUILTIN_PEERS: [&str; 6] = [
+pub const BUILTIN_PEERS: [&str; 7] = [
     "mitsuba",
+    "mitsuba-ptracer",
     "luxcore",
     "cycles",
     "smallvcm-ppm",

@@ -78,7 +78,7 @@ pub(crate) struct BenchSplat {
     pub(crate) runs: usize,
 }
 
-/// photonflow's sppm, path+splat and path against peer renderers at fixed time budgets,
+/// photonflow's sppm, path+splat, path and light against peer renderers at fixed time budgets,
 /// one table per scene.
 ///
 /// In one run, every image is scored by its relative MSE against a reference given as two
@@ -108,9 +108,9 @@ pub(crate) struct BenchAccuracy {
     pub(crate) budgets: Vec<f64>,
     /// A peer: NAME, a built-in peer, or NAME=COMMAND, any renderer. Repeatable.
     ///
-    /// The built-in peers are tests/references/peer.sh's: mitsuba, luxcore, cycles,
-    /// smallvcm-ppm, smallvcm-bpt and smallvcm-vcm (SmallVCM knows only the worksheet
-    /// scene); they need PEERS and PEERS_VENV set, and Cycles BPY_VENV. NAME=COMMAND runs
+    /// The built-in peers are tests/references/peer.sh's: mitsuba, mitsuba-ptracer (its
+    /// light tracer), luxcore, cycles, smallvcm-ppm, smallvcm-bpt and smallvcm-vcm (SmallVCM
+    /// knows only the worksheet scene); they need PEERS and PEERS_VENV set, and Cycles BPY_VENV. NAME=COMMAND runs
     /// a shell command writing a linear EXR of the view of the scene file $SCENE to $OUT
     /// in about $BUDGET seconds.
     #[arg(long, value_parser = lab::accuracy::Peer::parse)]
