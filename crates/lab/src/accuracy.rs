@@ -11,12 +11,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// photonflow's methods in the table, in its column order.
-pub const METHODS: [Method; 4] = [
-    Method::Sppm,
-    Method::PathSplat,
-    Method::Path,
-    Method::Light,
-];
+pub const METHODS: [Method; 4] = [Method::Sppm, Method::PathSplat, Method::Path, Method::Light];
 
 /// The default budgets, in seconds.
 pub const BUDGETS: [f64; 4] = [2.0, 5.0, 15.0, 60.0];
