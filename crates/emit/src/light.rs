@@ -14,8 +14,8 @@
 //! `Φ_i / (p_i N)` at emission. Path `i` of pass `j` draws from its own stream, so a pass's
 //! splats are a pure function of the scene and `(j, i)`.
 
-use crate::trace::{glossy_roulette, scatter};
-use bsdf::{DiffuseLobe, TransportMode};
+use crate::trace::bounce;
+use bsdf::TransportMode;
 use film::Class;
 use geom::SurfacePoint;
 use glam::{DVec3, Vec3};
@@ -123,29 +123,11 @@ impl Tracer<'_> {
                 nd += 1;
                 self.connect(&hit, &bsdf, d, flux, class_of(first_specular, nd), out);
             }
-            if let Some(DiffuseLobe {
-                albedo, rest: None, ..
-            }) = bsdf.diffuse_lobe()
-            {
-                let survive = (albedo * flux).max_element() / flux.max_element();
-                if uc >= survive {
-                    return;
-                }
-                flux = flux * albedo / survive;
-            }
-            let Some((wi, s)) = scatter(&hit, bsdf, d, uc, u) else {
+            let Some((next, f, was_specular)) = bounce(&hit, bsdf, d, flux, uc, u, &mut rng) else {
                 return;
             };
-            if s.is_specular() {
-                flux *= s.weight();
-                specular += 1;
-            } else if !bsdf.is_diffuse() {
-                let Some(f) = glossy_roulette(flux, &s, &mut rng) else {
-                    return;
-                };
-                flux = f;
-            }
-            ray = hit.point.spawn_ray(wi);
+            specular += was_specular as u32;
+            (ray, flux) = (next, f);
         }
     }
 

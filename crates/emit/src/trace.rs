@@ -143,6 +143,40 @@ pub(crate) fn scatter(
     sides_agree(wo, wi, ng, wo_local, s.wi).then_some((wi, s))
 }
 
+/// A photon's way on from `hit`, reached along unit `d` with `flux`, by the rules of
+/// [`trace_range`]: Russian roulette on the albedo at a Lambertian vertex, the BSDF sampled
+/// ([`scatter`]), the sample's weight after a specular bounce and roulette on it after a
+/// glossy one. `None` when the photon ends; else its next ray, its flux and whether the
+/// bounce was specular. The photon tracer and the light tracer share it, so their paths
+/// follow the same rules.
+pub(crate) fn bounce(
+    hit: &geom::Hit,
+    bsdf: Bsdf,
+    d: Vec3,
+    mut flux: Vec3,
+    uc: f32,
+    u: [f32; 2],
+    rng: &mut Rng,
+) -> Option<(geom::Ray, Vec3, bool)> {
+    if let Some(DiffuseLobe {
+        albedo, rest: None, ..
+    }) = bsdf.diffuse_lobe()
+    {
+        let survive = (albedo * flux).max_element() / flux.max_element();
+        if uc >= survive {
+            return None;
+        }
+        flux = flux * albedo / survive;
+    }
+    let (wi, s) = scatter(hit, bsdf, d, uc, u)?;
+    if s.is_specular() {
+        flux *= s.weight();
+    } else if !bsdf.is_diffuse() {
+        flux = glossy_roulette(flux, &s, rng)?;
+    }
+    Some((hit.point.spawn_ray(wi), flux, s.is_specular()))
+}
+
 /// A photon's flux after a glossy bounce: the sample's weight, then Russian roulette on the
 /// share of the flux it keeps (Jensen 2001 §5.3 for the diffuse case); `None` when the
 /// photon ends. Its number is drawn here, at glossy hits only, so scenes without them keep
@@ -214,29 +248,11 @@ impl Tracer<'_> {
                 }
                 diffuse_bounces += 1;
             }
-            if let Some(DiffuseLobe {
-                albedo, rest: None, ..
-            }) = bsdf.diffuse_lobe()
-            {
-                let survive = (albedo * flux).max_element() / flux.max_element();
-                if uc >= survive {
-                    return;
-                }
-                flux = flux * albedo / survive;
-            }
-            let Some((wi, s)) = scatter(&hit, bsdf, d, uc, u) else {
+            let Some((next, f, specular)) = bounce(&hit, bsdf, d, flux, uc, u, &mut rng) else {
                 return;
             };
-            if s.is_specular() {
-                flux *= s.weight();
-                specular_bounces += 1;
-            } else if !bsdf.is_diffuse() {
-                let Some(f) = glossy_roulette(flux, &s, &mut rng) else {
-                    return;
-                };
-                flux = f;
-            }
-            ray = hit.point.spawn_ray(wi);
+            specular_bounces += specular as u32;
+            (ray, flux) = (next, f);
         }
     }
 }

@@ -49,7 +49,7 @@ pub(crate) struct Render {
     pub(crate) no_caustics: bool,
     /// Render only shard I of N (counted from 0) of the run, for `merge`.
     ///
-    /// `path` shards by its passes of samples, `caustic-splat` by its passes; the shard
+    /// `path` shards by its passes of samples, `caustic-splat` and `light` by their passes; the shard
     /// goes into a shard directory (--out, default out/shards/...). `merge` puts the
     /// shards back together into the one-machine result, byte for byte.
     #[arg(long, value_parser = render::shard::ShardId::parse)]

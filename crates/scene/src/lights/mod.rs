@@ -200,21 +200,21 @@ impl Light {
         }
     }
 
-    /// A photon: ray, point on the light, flux `Φ_i / (p_i N)` in the mean; `flux` is that
-    /// share for lights whose photons all carry it.
+    /// A photon: ray, point on the light, flux `Φ_i / (p_i N)` in the mean (`power` is
+    /// `Φ_i`; a triangle's photons all carry that share, as [`LightTable::flux`] gives it).
     fn emit(
         &self,
         u_pos: [f32; 2],
         u_dir: [f32; 2],
         pmf: f64,
-        flux: DVec3,
+        power: DVec3,
         photons: u64,
         sphere: &Sphere,
     ) -> (Ray, SurfacePoint, DVec3) {
         match self {
             Light::Area(l) => {
                 let (ray, point) = l.emit(u_pos, u_dir);
-                (ray, point, flux)
+                (ray, point, power / (pmf * photons as f64))
             }
             Light::Point(l) => l.emit(u_dir, pmf, photons),
             Light::Spot(l) => l.emit(u_dir, pmf, photons),
@@ -631,10 +631,9 @@ impl LightTable {
     pub fn emit(&self, u_light: f32, u_pos: [f32; 2], u_dir: [f32; 2], photons: u64) -> Emitted {
         let i = self.distribution.sample(u_light).0;
         let e = &self.entries[i];
-        let share = self.flux(i, photons);
         let (ray, point, flux) = e
             .light
-            .emit(u_pos, u_dir, e.pmf, share, photons, &self.sphere);
+            .emit(u_pos, u_dir, e.pmf, e.power, photons, &self.sphere);
         Emitted {
             ray,
             light: i,
