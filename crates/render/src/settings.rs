@@ -27,6 +27,32 @@ pub struct EstimateSettings {
     pub splat: SplatSettings,
     pub sppm: SppmSettings,
     pub light: LightSettings,
+    pub vcm: VcmSettings,
+}
+
+/// `[estimate.vcm]`: vertex connection and merging, one light and one eye subpath per pixel
+/// and pass.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct VcmSettings {
+    /// Passes: pass `j` traces new subpaths from streams `(seed, j, i)`; the image is their
+    /// mean. A time budget sets the passes it made.
+    pub passes: u32,
+    /// Merging radius of the first pass in scene units (0: a pixel's footprint at the
+    /// distance from the camera to the scene's centre).
+    pub radius: f32,
+    /// Radius reduction: pass `j` merges within `radius (j + 1)^((alpha - 1) / 2)`.
+    pub alpha: f32,
+}
+
+impl Default for VcmSettings {
+    fn default() -> Self {
+        VcmSettings {
+            passes: 16,
+            radius: 0.0,
+            alpha: 0.75,
+        }
+    }
 }
 
 /// `[estimate.light]`: light tracing, light paths connected to the camera.
@@ -195,6 +221,7 @@ impl Default for EstimateSettings {
             splat: SplatSettings::default(),
             sppm: SppmSettings::default(),
             light: LightSettings::default(),
+            vcm: VcmSettings::default(),
         }
     }
 }
@@ -267,6 +294,8 @@ pub enum Knob {
     SppmPasses,
     /// `[estimate.light] passes`.
     LightPasses,
+    /// `[estimate.vcm] passes`.
+    VcmPasses,
 }
 
 impl Knob {
@@ -278,6 +307,7 @@ impl Knob {
             Knob::SplatPasses => "estimate.splat.passes",
             Knob::SppmPasses => "estimate.sppm.passes",
             Knob::LightPasses => "estimate.light.passes",
+            Knob::VcmPasses => "estimate.vcm.passes",
         }
     }
 
@@ -292,7 +322,11 @@ impl Knob {
     pub const fn max(self) -> u32 {
         match self {
             Knob::RenderSpp => 1 << 24,
-            Knob::EstimateSpp | Knob::SplatPasses | Knob::SppmPasses | Knob::LightPasses => 1 << 20,
+            Knob::EstimateSpp
+            | Knob::SplatPasses
+            | Knob::SppmPasses
+            | Knob::LightPasses
+            | Knob::VcmPasses => 1 << 20,
         }
     }
 
@@ -314,6 +348,7 @@ impl Knob {
             Knob::SplatPasses => s.estimate.splat.passes,
             Knob::SppmPasses => s.estimate.sppm.passes,
             Knob::LightPasses => s.estimate.light.passes,
+            Knob::VcmPasses => s.estimate.vcm.passes,
         }
     }
 
@@ -324,6 +359,7 @@ impl Knob {
             Knob::SplatPasses => s.estimate.splat.passes = v,
             Knob::SppmPasses => s.estimate.sppm.passes = v,
             Knob::LightPasses => s.estimate.light.passes = v,
+            Knob::VcmPasses => s.estimate.vcm.passes = v,
         }
     }
 }
@@ -490,6 +526,7 @@ impl Settings {
             Knob::SplatPasses,
             Knob::SppmPasses,
             Knob::LightPasses,
+            Knob::VcmPasses,
         ] {
             let v = k.get(self);
             key(k.key(), &v, k.check(v))?;
@@ -543,6 +580,19 @@ impl Settings {
             return Err(format!(
                 "estimate.light.photons = {} is absurd (at most 2^40)",
                 e.light.photons
+            ));
+        }
+        let v = &e.vcm;
+        if !(v.radius >= 0.0 && v.radius.is_finite()) {
+            return Err(format!(
+                "estimate.vcm.radius = {} must be finite and >= 0 (0: automatic)",
+                v.radius
+            ));
+        }
+        if !(v.alpha > 0.0 && v.alpha <= 1.0) {
+            return Err(format!(
+                "estimate.vcm.alpha = {} must be in (0, 1]",
+                v.alpha
             ));
         }
         if sp.splits > 16 {

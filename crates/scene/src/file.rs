@@ -152,11 +152,15 @@ pub enum Method {
     /// Light tracing: light paths connected to the camera at every non-delta vertex
     /// (`[estimate.light]`); sharp caustics without a density estimate.
     Light,
+    /// Vertex connection and merging (Georgiev et al. 2012): path tracing, next-event
+    /// estimation, light tracing, bidirectional connections and merging, weighted per path
+    /// by MIS (`[estimate.vcm]`).
+    Vcm,
 }
 
 impl Method {
     /// Every method, in declaration order.
-    pub const ALL: [Method; 7] = [
+    pub const ALL: [Method; 8] = [
         Method::Path,
         Method::GlobalDirect,
         Method::FinalGather,
@@ -164,6 +168,7 @@ impl Method {
         Method::PathSplat,
         Method::Sppm,
         Method::Light,
+        Method::Vcm,
     ];
 
     /// The method's name as the scene file spells it.

@@ -36,8 +36,8 @@ pub use file::{
     RenderSettings, SamplerKind, SceneFile, SphereDesc,
 };
 pub use lights::{
-    AreaLight, Directional, Emitted, Environment, Light, LightSample, LightTable, MIN_EMIT_COS,
-    PointLight, SpotLight, Spread, Sun, TriangleLight,
+    AreaLight, Directional, EmitPdfs, Emitted, Environment, Light, LightSample, LightTable,
+    MIN_EMIT_COS, PointLight, SpotLight, Spread, Sun, TriangleLight,
 };
 pub use load::fnv1a64;
 pub use material::{ALPHA_RANGE, Material};

@@ -13,8 +13,10 @@ mod light;
 pub(crate) mod path;
 mod path_splat;
 pub(crate) mod sppm;
+mod vcm;
 
 pub use sppm::start_radius;
+pub use vcm::auto_radius as vcm_radius;
 
 use crate::rendered::Rendered;
 use crate::run::{BlocksFn, Run};
@@ -90,7 +92,7 @@ impl MethodRow {
 
 /// The method table: one row per `scene::Method`, in `Method::ALL`'s order. Nothing else
 /// matches on `Method`.
-pub static METHODS: [MethodRow; 7] = [
+pub static METHODS: [MethodRow; 8] = [
     MethodRow {
         method: Method::Path,
         help: "the path-traced reference: next-event estimation and BSDF sampling by MIS, in \
@@ -192,6 +194,22 @@ pub static METHODS: [MethodRow; 7] = [
         whole_image: true,
         render: light::render,
         blocks: Ok(light::blocks),
+    },
+    MethodRow {
+        method: Method::Vcm,
+        help: "vertex connection and merging (Georgiev et al. 2012): path tracing, light \
+               tracing, bidirectional connections and merging in passes, each path weighted \
+               by MIS over all of them",
+        table: "[estimate.vcm]",
+        // Not `EyePaths`: `--no-caustics` configures the path tracer alone.
+        reads: &[Input::LightPaths],
+        // One eye and one light subpath per pixel and pass.
+        spp: None,
+        passes: Some(Knob::VcmPasses),
+        work: Work::PixelSamples(Knob::VcmPasses),
+        whole_image: true,
+        render: vcm::render,
+        blocks: Ok(vcm::blocks),
     },
 ];
 

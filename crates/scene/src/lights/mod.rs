@@ -89,6 +89,23 @@ pub struct LightSample {
     pub delta: bool,
 }
 
+/// The densities with which a light emits a ray leaving it along a direction, which the
+/// combined method's MIS weights compare (Georgiev et al. 2012, "Light transport simulation
+/// with vertex connection and merging", §4 and its technical report's Table 1; SmallVCM's
+/// `Emit`/`Illuminate`/`GetRadiance`). The light's choice probability is included in both.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EmitPdfs {
+    /// Density of emitting the ray: area (or disc) times direction density. Zero where the
+    /// light cannot emit along it.
+    pub emit: f32,
+    /// Density of next-event estimation choosing the light's point: per unit area for a
+    /// light at a position (1 for a point or spot light's only point), per unit solid angle
+    /// for a light at infinity (1 for a directional light's only direction).
+    pub direct: f32,
+    /// Cosine between the ray and the light's normal (1 for lights without one).
+    pub cos: f32,
+}
+
 /// A photon leaving a light.
 #[derive(Clone, Copy, Debug)]
 pub struct Emitted {
@@ -640,6 +657,49 @@ impl LightTable {
             point,
             flux,
         }
+    }
+
+    /// [`EmitPdfs`] of light `light` emitting along unit `d` (leaving it), for a ray that
+    /// leaves a triangle light or one at infinity; zeros where the light cannot send it.
+    pub fn emit_pdfs(&self, light: usize, d: Vec3) -> EmitPdfs {
+        let e = &self.entries[light];
+        let pmf = e.pmf as f32;
+        let disc = 1.0 / (std::f32::consts::PI * self.sphere.radius * self.sphere.radius);
+        let (emit, direct, cos) = match &e.light {
+            Light::Area(l) => {
+                let cos = d.dot(l.normal);
+                if cos <= 0.0 {
+                    (0.0, 0.0, 0.0)
+                } else {
+                    (
+                        cos * std::f32::consts::FRAC_1_PI / l.area,
+                        1.0 / l.area,
+                        cos,
+                    )
+                }
+            }
+            Light::Point(_) => (0.25 * std::f32::consts::FRAC_1_PI, 1.0, 1.0),
+            Light::Spot(l) => {
+                let inside = l.frame.n.dot(d) > l.cutoff.cos();
+                (if inside { 1.0 / l.cone() as f32 } else { 0.0 }, 1.0, 1.0)
+            }
+            Light::Directional(_) => (disc, 1.0, 1.0),
+            Light::Sun(_) | Light::Environment(_) => {
+                let p = e.light.pdf_dir(-d);
+                (p * disc, p, 1.0)
+            }
+        };
+        EmitPdfs {
+            emit: emit * pmf,
+            direct: direct * pmf,
+            cos,
+        }
+    }
+
+    /// Whether light `i` sits at a position (a triangle, point or spot light), so densities
+    /// towards it convert between area and solid angle.
+    pub fn is_finite(&self, i: usize) -> bool {
+        !self.entries[i].light.is_infinite()
     }
 
     /// The cells of photon `e` (see [`Spread`]) when `photons` paths are emitted in all.

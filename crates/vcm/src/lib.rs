@@ -1,0 +1,184 @@
+//! `vcm`: vertex connection and merging (Georgiev, Křivánek, Davidovič and Slusallek 2012,
+//! "Light transport simulation with vertex connection and merging"; Hachisuka, Pantaleoni
+//! and Jensen 2012 derive the same combination). Every pass traces one light subpath per
+//! pixel, stores its non-delta vertices and joins each to the camera, then traces one eye
+//! subpath per pixel that at every non-delta vertex
+//! - counts emission it hits (path tracing),
+//! - samples a light (next-event estimation),
+//! - connects to each vertex of its pixel's light subpath (bidirectional connections), and
+//! - merges with the light vertices within the pass's radius (photon mapping's density
+//!   estimate, the radius shrinking per pass as in progressive photon mapping),
+//!
+//! and every full path is weighted by the power heuristic over all the strategies that could
+//! have made it, so it is counted once, mostly by the strategies that see it best: a sharp
+//! caustic seen directly by light tracing, a caustic seen through glass by merging, a diffuse
+//! box by path tracing and connections.
+//!
+//! The weights use the recursive partial sums `dVCM`, `dVC`, `dVM` each subpath carries
+//! (the paper's technical report, §6.3; SmallVCM's `vertexcm.hxx` spells them out), so a
+//! weight costs a few products whatever the path's length. They leave out Russian roulette
+//! (it changes how often a strategy runs, not which paths it can make), so they still sum to
+//! one over the strategies: the estimate is unbiased but for merging's own bias.
+//!
+//! Determinism: light path `i` and the eye path of pixel `i` of pass `j` draw from their own
+//! streams of `(seed, j, i)`, the light vertices keep path order, and the grid visits them in
+//! an order fixed by the vertices, so a pass is a pure function of the scene and `j` for any
+//! split into chunks and any thread count.
+
+mod eye;
+mod grid;
+mod light;
+#[cfg(test)]
+mod tests;
+
+pub use eye::{LightSide, eye_paths};
+pub use grid::Grid;
+pub use light::{CameraSplat, LightVertex, light_paths};
+
+use bsdf::BsdfSample;
+use glam::Vec3;
+use math::mix64;
+use scene::Scene;
+
+/// Which strategies run (all, for rendering; tests switch one off to see it matter).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Strategies {
+    /// Emission found by eye paths (unidirectional path tracing).
+    pub hits: bool,
+    /// Next-event estimation at eye vertices.
+    pub nee: bool,
+    /// Light vertices joined to the camera (light tracing).
+    pub camera: bool,
+    /// Eye vertices joined to their pixel's light vertices.
+    pub connect: bool,
+    /// Eye vertices merged with light vertices within the radius.
+    pub merge: bool,
+}
+
+impl Strategies {
+    pub const ALL: Strategies = Strategies {
+        hits: true,
+        nee: true,
+        camera: true,
+        connect: true,
+        merge: true,
+    };
+}
+
+/// The method's knobs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    /// Longest path in bounces, as the path tracer counts them.
+    pub max_depth: u32,
+    /// Russian roulette from this many bounces on, on both subpaths.
+    pub rr_depth: u32,
+    /// Merging radius of the first pass, in scene units.
+    pub radius: f32,
+    /// Radius reduction: pass `j` (from 0) merges within `radius (j + 1)^((alpha - 1) / 2)`
+    /// (Knaus and Zwicker 2011's progressive photon mapping).
+    pub alpha: f32,
+    /// Which strategies contribute. Weights always count all five, so a switched-off
+    /// strategy leaves its share of each path out.
+    pub strategies: Strategies,
+}
+
+/// The power heuristic's `p^2` (Veach 1997 §9.2.4), applied to each density ratio.
+#[inline]
+pub(crate) fn mis(p: f32) -> f32 {
+    p * p
+}
+
+/// Mixed into a pass's streams ("vcmlight", "vcm eye " in ASCII).
+const LIGHT_STREAM: u64 = 0x7663_6d6c_6967_6874;
+const EYE_STREAM: u64 = 0x7663_6d20_6579_6520;
+
+/// What one pass shares between its light and eye subpaths.
+#[derive(Clone, Copy, Debug)]
+pub struct Pass {
+    pub opts: Options,
+    /// Light subpaths of the pass: one per pixel.
+    pub light_paths: u64,
+    /// This pass's merging radius.
+    pub radius: f32,
+    /// `mis(π r² N)`: merging's weight relative to connections (the paper's `η_VCM`).
+    pub(crate) vm_factor: f32,
+    /// `mis(1 / (π r² N))`.
+    pub(crate) vc_factor: f32,
+    /// Merging's kernel normalisation `1 / (π r² N)` (uniform kernel).
+    pub(crate) vm_norm: f32,
+    pub(crate) light_stream: u64,
+    pub(crate) eye_stream: u64,
+    /// Longest path in segments: `max_depth + 1`.
+    pub(crate) max_len: u32,
+}
+
+impl Pass {
+    /// Pass `pass` (from 0) of a run over `scene`.
+    pub fn new(scene: &Scene, opts: Options, pass: u64) -> Pass {
+        let light_paths = scene.camera.width as u64 * scene.camera.height as u64;
+        let shrink = ((pass + 1) as f64).powf(0.5 * (opts.alpha as f64 - 1.0));
+        let radius = (opts.radius as f64 * shrink).max(1e-7) as f32;
+        let eta = std::f64::consts::PI * (radius as f64).powi(2) * light_paths as f64;
+        let stream = mix64(scene.seed() ^ mix64(pass.wrapping_add(0x0056_434d)));
+        Pass {
+            opts,
+            light_paths,
+            radius,
+            vm_factor: mis(eta as f32),
+            vc_factor: mis((1.0 / eta) as f32),
+            vm_norm: (1.0 / eta) as f32,
+            light_stream: stream ^ LIGHT_STREAM,
+            eye_stream: stream ^ EYE_STREAM,
+            max_len: opts.max_depth.saturating_add(1),
+        }
+    }
+}
+
+/// A subpath's state between vertices: the ray it follows, its throughput and the partial
+/// MIS sums (the technical report's Eqs. 34-38).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SubPath {
+    pub throughput: Vec3,
+    /// Segments so far, the one being traced included.
+    pub length: u32,
+    pub d_vcm: f32,
+    pub d_vc: f32,
+    pub d_vm: f32,
+}
+
+impl SubPath {
+    /// Arrival at a vertex `dist` away whose cosine to the incoming direction is `cos`: the
+    /// sums move from solid angle at the last vertex to area at this one (skipping the
+    /// distance for the first segment of a light at infinity, whose density is per area).
+    #[inline]
+    pub fn arrive(&mut self, dist2: f32, cos: f32, with_distance: bool) {
+        if with_distance {
+            self.d_vcm *= mis(dist2);
+        }
+        let c = mis(cos.abs());
+        self.d_vcm /= c;
+        self.d_vc /= c;
+        self.d_vm /= c;
+    }
+
+    /// The sums after sampling `s` at a vertex whose reverse density (of sampling the way
+    /// the subpath came, given `s.wi`) is `rev_pdf`.
+    #[inline]
+    pub fn scatter(&mut self, s: &BsdfSample, rev_pdf: f32, pass: &Pass) {
+        let cos_out = s.wi.z.abs();
+        if s.is_specular() {
+            // A delta lobe's forward and reverse probabilities are equal (Fresnel is
+            // symmetric), so only the cosine survives; no strategy but the subpath itself
+            // ends here.
+            self.d_vcm = 0.0;
+            self.d_vc *= mis(cos_out);
+            self.d_vm *= mis(cos_out);
+        } else {
+            let k = mis(cos_out / s.pdf);
+            self.d_vc = k * (self.d_vc * mis(rev_pdf) + self.d_vcm + pass.vm_factor);
+            self.d_vm = k * (self.d_vm * mis(rev_pdf) + self.d_vcm * pass.vc_factor + 1.0);
+            self.d_vcm = mis(1.0 / s.pdf);
+        }
+        self.throughput *= s.weight();
+    }
+}

@@ -1,0 +1,209 @@
+//! Light subpaths: emitted, traced, their non-delta vertices stored for connections and
+//! merging and joined to the camera (light tracing, the `t = 1` strategy).
+
+use crate::{Pass, SubPath, mis};
+use bsdf::{Bsdf, TransportMode};
+use geom::{Ray, SurfacePoint};
+use glam::{DVec3, Vec3};
+use math::{Frame, Rng};
+use scene::{Scene, sides_agree};
+use std::ops::Range;
+
+/// A stored light vertex: where a light subpath reached a non-delta surface.
+#[derive(Clone, Copy, Debug)]
+pub struct LightVertex {
+    /// Position, its error bound and the geometric normal.
+    pub point: SurfacePoint,
+    /// The shading normal the BSDF's frame is built on.
+    pub ns: Vec3,
+    /// Unit direction back towards the previous vertex.
+    pub wo: Vec3,
+    /// Throughput on arrival (emission over the densities so far, the BSDF here excluded).
+    pub throughput: Vec3,
+    pub bsdf: Bsdf,
+    /// Segments from the light.
+    pub length: u32,
+    pub d_vcm: f32,
+    pub d_vc: f32,
+    pub d_vm: f32,
+}
+
+/// A light vertex's contribution through the camera to pixel `pixel` (already over the
+/// pass's path count and MIS-weighted), in f64 as the light tracer's splats are.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraSplat {
+    pub pixel: u32,
+    pub value: DVec3,
+}
+
+/// Traces light subpaths `range` of `pass`: appends their vertices in path order to
+/// `vertices`, each path's vertex count to `counts`, and their camera splats to `splats`.
+pub fn light_paths(
+    scene: &Scene,
+    pass: &Pass,
+    range: Range<u64>,
+    vertices: &mut Vec<LightVertex>,
+    counts: &mut Vec<u32>,
+    splats: &mut Vec<CameraSplat>,
+) {
+    let eye = SurfacePoint {
+        p: scene.camera.eye,
+        p_err: Vec3::ZERO,
+        n: scene.camera.forward(),
+    };
+    for i in range {
+        let before = vertices.len();
+        trace(scene, pass, &eye, i, vertices, splats);
+        counts.push((vertices.len() - before) as u32);
+    }
+}
+
+fn trace(
+    scene: &Scene,
+    pass: &Pass,
+    eye: &SurfacePoint,
+    index: u64,
+    vertices: &mut Vec<LightVertex>,
+    splats: &mut Vec<CameraSplat>,
+) {
+    let lights = &scene.light_table;
+    let mut rng = Rng::for_index(pass.light_stream, index);
+    // Fixed layout: 5 numbers to emit, then 4 per hit, used or not.
+    let (u_light, u_pos, u_dir) = (rng.uniform(), rng.uniform2(), rng.uniform2());
+    let e = lights.emit(u_light, u_pos, u_dir, 1);
+    let pdfs = lights.emit_pdfs(e.light, e.ray.d);
+    let throughput = e.flux.as_vec3();
+    if !(pdfs.emit > 0.0 && throughput.is_finite() && throughput.cmpgt(Vec3::ZERO).any()) {
+        return;
+    }
+    let finite = lights.is_finite(e.light);
+    let delta = lights.is_delta(e.light);
+    // The technical report's Eqs. 31-33 (SmallVCM's `GenerateLightSample`): a light that
+    // BSDF sampling can never hit has no `dVC` term.
+    let d_vc = if delta {
+        0.0
+    } else {
+        mis(if finite { pdfs.cos } else { 1.0 } / pdfs.emit)
+    };
+    let mut path = SubPath {
+        throughput,
+        length: 1,
+        d_vcm: mis(pdfs.direct / pdfs.emit),
+        d_vc,
+        d_vm: d_vc * pass.vc_factor,
+    };
+    let mut ray: Ray = e.ray;
+    loop {
+        let Some(hit) = scene.geometry.intersect(&ray) else {
+            return;
+        };
+        path.throughput *= scene.transmittance_to(&hit, &ray);
+        let (uc, u, u_rr) = (rng.uniform(), rng.uniform2(), rng.uniform());
+        let Some(bsdf) = scene.bsdf_at(&hit) else {
+            return;
+        };
+        let d = ray.d.normalize();
+        let frame = Frame::from_z(hit.ns);
+        let wo = -d;
+        let wo_l = frame.to_local(wo);
+        let dist = hit.t * ray.d.length();
+        path.arrive(dist * dist, wo_l.z, path.length > 1 || finite);
+        if !bsdf.is_delta() {
+            let v = LightVertex {
+                point: hit.point,
+                ns: hit.ns,
+                wo,
+                throughput: path.throughput,
+                bsdf,
+                length: path.length,
+                d_vcm: path.d_vcm,
+                d_vc: path.d_vc,
+                d_vm: path.d_vm,
+            };
+            if pass.opts.strategies.camera
+                && path.length < pass.max_len
+                && let Some(s) = to_camera(scene, pass, &v, eye)
+            {
+                splats.push(s);
+            }
+            vertices.push(v);
+        }
+        if path.length + 2 > pass.max_len {
+            return;
+        }
+        if wo_l.z * wo.dot(hit.point.n) <= 0.0 {
+            return;
+        }
+        let Some(s) = bsdf.sample(wo_l, uc, u, TransportMode::Importance) else {
+            return;
+        };
+        let wi = frame.to_world(s.wi).normalize();
+        if !sides_agree(wo, wi, hit.point.n, wo_l, s.wi) {
+            return;
+        }
+        let rev = if s.is_specular() {
+            s.pdf
+        } else {
+            bsdf.pdf(s.wi, wo_l)
+        };
+        let before = path.throughput.max_element();
+        path.scatter(&s, rev, pass);
+        // Russian roulette on the share of the throughput the bounce keeps, so survivors
+        // never carry more than they arrived with (Jensen 2001 §5.3's rule for photons).
+        if path.length >= pass.opts.rr_depth {
+            let q = (path.throughput.max_element() / before).min(1.0);
+            if u_rr >= q || q.is_nan() {
+                return;
+            }
+            path.throughput /= q;
+        }
+        if !path.throughput.cmpgt(Vec3::ZERO).any() {
+            return;
+        }
+        path.length += 1;
+        ray = hit.point.spawn_ray(wi);
+    }
+}
+
+/// Light vertex `v` joined to the pinhole: its throughput times the BSDF towards the eye and
+/// the camera's density of seeing it, weighted against every other strategy (the technical
+/// report's Eq. 44; pbrt-v4 §16.3.3's `t = 1`).
+fn to_camera(
+    scene: &Scene,
+    pass: &Pass,
+    v: &LightVertex,
+    eye: &SurfacePoint,
+) -> Option<CameraSplat> {
+    let cam = &scene.camera;
+    let proj = cam.project(v.point.p)?;
+    let frame = Frame::from_z(v.ns);
+    let wi = -proj.dir;
+    let (wo_l, wi_l) = (frame.to_local(v.wo), frame.to_local(wi));
+    if !sides_agree(v.wo, wi, v.point.n, wo_l, wi_l) {
+        return None;
+    }
+    let f = v.bsdf.f(wo_l, wi_l, TransportMode::Importance);
+    if f == Vec3::ZERO {
+        return None;
+    }
+    let rev = v.bsdf.pdf(wi_l, wo_l);
+    // The camera's density of this point per unit area, over all of a pass's pixel samples:
+    // `W_e cos_e` per unit solid angle (the importance is per pixel), then to area.
+    let dist2 = proj.dist * proj.dist;
+    let camera_pdf_a = cam.importance(proj.cos) * proj.cos * wi_l.z.abs() / dist2;
+    let n = pass.light_paths as f32;
+    let w_light = mis(camera_pdf_a / n) * (pass.vm_factor + v.d_vcm + v.d_vc * mis(rev));
+    let weight = 1.0 / (1.0 + w_light);
+    let value =
+        v.throughput.as_dvec3() * f.as_dvec3() * (camera_pdf_a as f64 / n as f64) * weight as f64;
+    if !(value.is_finite() && value.cmpgt(DVec3::ZERO).any()) {
+        return None;
+    }
+    if scene.geometry.occluded(&v.point.spawn_ray_to_point(eye)) {
+        return None;
+    }
+    Some(CameraSplat {
+        pixel: proj.pixel,
+        value,
+    })
+}
