@@ -4,13 +4,13 @@ pub const HELP: &str = "\
 cargo xtask <command>   (the photonflow commands build the release `photonflow` binary and run
                          it; `photonflow <command> --help` has every option and the details)
 
-  render SCENE [--method path|global-direct|final-gather|caustic-splat|path+splat|sppm|light]
+  render SCENE [--method path|global-direct|final-gather|caustic-splat|path+splat|sppm|light|vcm]
                [--spp N] [--passes N] [--time S] [--threads N] [--out DIR]
                       render with a progress bar; writes image.exr, image.png, layers/, image.json
                       and scene.toml (the resolved scene: renders the same image again).
                       path: the path-traced reference (--no-caustics leaves out L S+ D light);
                       the photon methods chain trace (or reuse the cache) -> estimate -> composite;
-                      sppm, light and the splatting methods run in passes (--passes, --time) and
+                      sppm, light, vcm and the splatting methods run in passes (--passes, --time) and
                       write snapshots at 1, 2, 4, ... passes;
                       without --method: the scene's render.method (default sppm)
   trace SCENE [--photons N] [--cache DIR] [--threads N] [--force]
@@ -63,7 +63,7 @@ cargo xtask <command>   (the photonflow commands build the release `photonflow` 
                       peak memory (default scene: scenes/cornell-spheres/analytic.toml)
   bench accuracy [--case SCENE.toml,REF_A.exr,REF_B.exr]... [--suite FILE] [--refs DIR]
                  [--budgets 2,5,15,60] [--peer NAME | --peer NAME=CMD]...
-                      photonflow's sppm, path+splat, path and light and the peers at fixed
+                      photonflow's sppm, vcm, path+splat, path and light and the peers at fixed
                       time budgets, in one run: the relative MSE of each image against the
                       scene's two reference halves, the reference's noise taken out; per
                       budget the best of each side, the error ratio and photonflow's time to

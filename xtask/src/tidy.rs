@@ -23,6 +23,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("film", &["temps"]),
     ("store", &["math", "temps"]),
     ("eye", &["math", "geom", "scene", "bsdf", "film"]),
+    // Both subpaths of vertex connection and merging: a stage of its own, beside `eye` and
+    // `emit`, knowing neither.
+    ("vcm", &["math", "geom", "scene", "bsdf"]),
     (
         "emit",
         &["math", "geom", "scene", "bsdf", "film", "store", "flow"],
@@ -62,6 +65,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "film",
             "store",
             "eye",
+            "vcm",
             "emit",
             "density",
             "composite",
@@ -81,6 +85,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "film",
             "store",
             "eye",
+            "vcm",
             "emit",
             "density",
             "composite",

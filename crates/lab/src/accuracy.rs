@@ -11,7 +11,13 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// photonflow's methods in the table, in its column order.
-pub const METHODS: [Method; 4] = [Method::Sppm, Method::PathSplat, Method::Path, Method::Light];
+pub const METHODS: [Method; 5] = [
+    Method::Sppm,
+    Method::Vcm,
+    Method::PathSplat,
+    Method::Path,
+    Method::Light,
+];
 
 /// The default budgets, in seconds.
 pub const BUDGETS: [f64; 4] = [2.0, 5.0, 15.0, 60.0];
@@ -33,6 +39,56 @@ pub struct Case {
     pub scene: PathBuf,
     pub reference_a: PathBuf,
     pub reference_b: PathBuf,
+    pub pixels: Pixels,
+}
+
+/// The pixels a case is scored over.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Pixels {
+    /// Every pixel.
+    #[default]
+    All,
+    /// Pixels whose camera rays all meet a non-delta surface first: the only ones a light
+    /// tracer's reference defines (no light path joins the pinhole through glass or a
+    /// mirror, nor draws the emitters it starts from), so every renderer is scored where
+    /// both it and the reference see.
+    DiffuseSeen,
+}
+
+/// Sub-pixel rays per axis that decide [`Pixels::DiffuseSeen`].
+const MASK_RAYS: usize = 4;
+
+/// The pixels of `scene` that `pixels` selects (`None`: all).
+pub fn mask(scene: &Scene, pixels: Pixels) -> Option<film::Mask> {
+    if pixels == Pixels::All {
+        return None;
+    }
+    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+    let diffuse = |x: f32, y: f32| {
+        scene
+            .geometry
+            .intersect(&scene.camera.ray(x, y))
+            .is_some_and(|hit| {
+                scene.light_table.light_of(hit.prim).is_none()
+                    && scene.bsdf_at(&hit).is_some_and(|b| !b.is_delta())
+            })
+    };
+    let step = 1.0 / MASK_RAYS as f32;
+    let pixels = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32, (i / w) as f32);
+            (0..MASK_RAYS * MASK_RAYS).all(|k| {
+                let (u, v) = ((k % MASK_RAYS) as f32, (k / MASK_RAYS) as f32);
+                diffuse(x + (u + 0.5) * step, y + (v + 0.5) * step)
+            })
+        })
+        .collect();
+    Some(film::Mask {
+        width: w,
+        height: h,
+        pixels,
+    })
 }
 
 impl Case {
@@ -43,14 +99,15 @@ impl Case {
                 scene: scene.into(),
                 reference_a: a.into(),
                 reference_b: b.into(),
+                pixels: Pixels::All,
             }),
             _ => Err(format!("`{s}`: expected SCENE.toml,REF_A.exr,REF_B.exr")),
         }
     }
 }
 
-/// The cases of a suite file: `[[case]]` tables with `scene`, `reference_a` and
-/// `reference_b`. Scenes are relative to the suite file, references to `refs` if given (where
+/// The cases of a suite file: `[[case]]` tables with `scene`, `reference_a`, `reference_b`
+/// and optionally `pixels` ([`Pixels`], kebab-case: `"diffuse-seen"`). Scenes are relative to the suite file, references to `refs` if given (where
 /// the big reference images are kept), else to the suite file too.
 pub fn read_suite(path: &Path, refs: Option<&Path>) -> Result<Vec<Case>, String> {
     #[derive(serde::Deserialize)]
@@ -64,6 +121,8 @@ pub fn read_suite(path: &Path, refs: Option<&Path>) -> Result<Vec<Case>, String>
         scene: PathBuf,
         reference_a: PathBuf,
         reference_b: PathBuf,
+        #[serde(default)]
+        pixels: Pixels,
     }
     let err = |e: String| format!("{}: {e}", path.display());
     let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
@@ -77,6 +136,7 @@ pub fn read_suite(path: &Path, refs: Option<&Path>) -> Result<Vec<Case>, String>
             scene: here.join(e.scene),
             reference_a: refs.join(e.reference_a),
             reference_b: refs.join(e.reference_b),
+            pixels: e.pixels,
         })
         .collect())
 }
@@ -207,11 +267,17 @@ pub fn tables(budgets: &[f64], ours: &[Column], peers: &[Column]) -> String {
     s + "\n"
 }
 
+/// What an image is scored against: the reference's halves and the pixels scored.
+pub struct Scoring {
+    pub halves: film::Halves,
+    pub mask: Option<film::Mask>,
+}
+
 /// The corrected relative MSE of the image at `exr`.
-fn corrected(halves: &film::Halves, exr: &Path) -> Result<f64, String> {
+fn corrected(scoring: &Scoring, exr: &Path) -> Result<f64, String> {
     let img = render::output::read_finite(exr, "pixels")?;
-    let m =
-        film::metrics_halves(&img, halves, None).map_err(|e| format!("{}: {e}", exr.display()))?;
+    let m = film::metrics_halves(&img, &scoring.halves, scoring.mask.as_ref())
+        .map_err(|e| format!("{}: {e}", exr.display()))?;
     Ok(m.relmse)
 }
 
@@ -222,7 +288,7 @@ fn run_ours(
     budget: f64,
     out: &Path,
     cache: &Path,
-    halves: &film::Halves,
+    scoring: &Scoring,
 ) -> Result<Rung, String> {
     // A photon cache left from another run would make tracing free.
     let _ = std::fs::remove_dir_all(cache);
@@ -248,7 +314,7 @@ fn run_ours(
     let _ = std::fs::remove_dir_all(cache);
     Ok(Rung {
         seconds,
-        relmse: corrected(halves, &out.join("image.exr"))?,
+        relmse: corrected(scoring, &out.join("image.exr"))?,
     })
 }
 
@@ -282,7 +348,7 @@ fn run_peer(
     scene: &Path,
     budget: f64,
     exr: &Path,
-    halves: &film::Halves,
+    scoring: &Scoring,
     note: &mut Option<String>,
 ) -> Result<Rung, String> {
     let _ = std::fs::remove_file(exr);
@@ -311,7 +377,7 @@ fn run_peer(
     }
     Ok(Rung {
         seconds,
-        relmse: corrected(halves, exr)?,
+        relmse: corrected(scoring, exr)?,
     })
 }
 
@@ -340,12 +406,15 @@ pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> 
         let scene_abs = std::fs::canonicalize(&case.scene)
             .map_err(|e| format!("{}: {e}", case.scene.display()))?;
         let case_dir = abs.join(format!("case-{k}"));
-        let halves = crate::reference::halves(
-            &scene,
-            &case.reference_a,
-            &case.reference_b,
-            &case_dir.join("reference-halves-mean.exr"),
-        )?;
+        let scoring = Scoring {
+            halves: crate::reference::halves(
+                &scene,
+                &case.reference_a,
+                &case.reference_b,
+                &case_dir.join("reference-halves-mean.exr"),
+            )?,
+            mask: mask(&scene, case.pixels),
+        };
         println!(
             "\n{} ({}, {}x{}), reference halves {} and {}",
             scene.file.name,
@@ -355,6 +424,14 @@ pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> 
             case.reference_a.display(),
             case.reference_b.display()
         );
+        if let Some(m) = &scoring.mask {
+            println!(
+                "scored over the {} of {} pixels whose camera rays all meet a non-delta surface \
+                 first (a light tracer's reference defines no others)",
+                m.pixels.iter().filter(|p| **p).count(),
+                m.pixels.len()
+            );
+        }
         let column = |name: &str| Column {
             name: name.into(),
             cells: Vec::new(),
@@ -369,7 +446,7 @@ pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> 
         let mut out_of: Vec<Option<String>> = Vec::new();
         for (p, note) in peers.iter().zip(&mut notes) {
             let exr = case_dir.join(format!("peer-{}-warm-up.exr", p.name));
-            let r = run_peer(p, &scene_abs, smallest, &exr, &halves, note);
+            let r = run_peer(p, &scene_abs, smallest, &exr, &scoring, note);
             if let Err(e) = &r {
                 println!("{:<14} warm-up: did not run: {e}", p.name);
             }
@@ -378,7 +455,7 @@ pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> 
         for &b in budgets {
             for (m, col) in METHODS.iter().zip(&mut ours) {
                 let out = case_dir.join(format!("{}-{b}s", m.name().replace('+', "-")));
-                let r = run_ours(&scene, *m, b, &out, &cache, &halves)?;
+                let r = run_ours(&scene, *m, b, &out, &cache, &scoring)?;
                 println!(
                     "{:<14} {b:>5} s budget {:8.2} s  relMSE {:.5}{}",
                     col.name,
@@ -396,7 +473,7 @@ pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> 
                     continue;
                 }
                 let exr = case_dir.join(format!("peer-{}-{b}s.exr", p.name));
-                let r = run_peer(p, &scene_abs, b, &exr, &halves, note);
+                let r = run_peer(p, &scene_abs, b, &exr, &scoring, note);
                 match &r {
                     Ok(r) => println!(
                         "{:<14} {b:>5} s budget {:8.2} s  relMSE {:.5}",

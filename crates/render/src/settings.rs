@@ -43,6 +43,38 @@ pub struct VcmSettings {
     pub radius: f32,
     /// Radius reduction: pass `j` merges within `radius (j + 1)^((alpha - 1) / 2)`.
     pub alpha: f32,
+    /// Which strategies add to the image (all by default). The MIS weights still count
+    /// every strategy, so one switched off leaves out exactly its share of each path: the
+    /// image shows what the others carry.
+    pub strategies: VcmStrategies,
+}
+
+/// `[estimate.vcm.strategies]`: one switch per strategy.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct VcmStrategies {
+    /// Emission an eye path hits (path tracing).
+    pub hits: bool,
+    /// Next-event estimation at eye vertices.
+    pub nee: bool,
+    /// Light vertices joined to the camera (light tracing).
+    pub camera: bool,
+    /// Eye vertices joined to their pixel's light vertices.
+    pub connect: bool,
+    /// Light vertices within the radius merged at eye vertices.
+    pub merge: bool,
+}
+
+impl Default for VcmStrategies {
+    fn default() -> Self {
+        VcmStrategies {
+            hits: true,
+            nee: true,
+            camera: true,
+            connect: true,
+            merge: true,
+        }
+    }
 }
 
 impl Default for VcmSettings {
@@ -51,6 +83,7 @@ impl Default for VcmSettings {
             passes: 16,
             radius: 0.0,
             alpha: 0.75,
+            strategies: VcmStrategies::default(),
         }
     }
 }

@@ -27,7 +27,13 @@ pub(crate) fn options(run: &Run) -> vcm::Options {
             auto_radius(run.scene)
         },
         alpha: v.alpha,
-        strategies: vcm::Strategies::ALL,
+        strategies: vcm::Strategies {
+            hits: v.strategies.hits,
+            nee: v.strategies.nee,
+            camera: v.strategies.camera,
+            connect: v.strategies.connect,
+            merge: v.strategies.merge,
+        },
     }
 }
 
