@@ -193,6 +193,7 @@ const CASES: &[Case] = &[
                 Method::FinalGather,
                 Method::Sppm,
                 Method::Light,
+                Method::Vcm,
             ])
         },
         check: check_degenerate,
@@ -228,6 +229,7 @@ const CASES: &[Case] = &[
                 Method::PathSplat,
                 Method::Sppm,
                 Method::Light,
+                Method::Vcm,
             ])
         },
         check: check_huge_power,
@@ -327,6 +329,10 @@ fn quick(method: Method) -> Overrides {
         },
         Method::Light => Overrides {
             photons: Some(20_000),
+            passes: Some(2),
+            ..o
+        },
+        Method::Vcm => Overrides {
             passes: Some(2),
             ..o
         },
@@ -1286,6 +1292,7 @@ fn worksheet_runs() -> Vec<Overrides> {
         Method::FinalGather,
         Method::CausticSplat,
         Method::Sppm,
+        Method::Vcm,
     ])
 }
 
@@ -1350,6 +1357,7 @@ fn check_scaled(ctx: &Ctx) {
             (Method::FinalGather, t),
             (Method::CausticSplat, t),
             (Method::Sppm, t),
+            (Method::Vcm, t),
         ],
     );
 }

@@ -436,3 +436,26 @@ fn sphere_under_a_constant_environment_image() {
         ),
     );
 }
+
+/// Vertex connection and merging under a directional light and under the 5-degree sun disc:
+/// the floor's mean against `ρ/π E cos θ` within 4 standard errors plus merging's bias at the
+/// floor's edge (0.5%). Every strategy weighs these paths: light paths start on the disc of
+/// radius `R` (its density per area is the emission density), NEE towards the direction
+/// (delta for the directional light, the disc's cone for the sun), the camera and merging.
+/// Measured (16 x 16, 16 passes): TABLE_INF
+#[test]
+fn directional_and_sun_over_a_plane_vcm() {
+    for (name, angle) in [("directional", None), ("sun", Some(5.0))] {
+        let dir = TempDir::new("vcm-distant-plane");
+        let scene = floor(&dir, &directional(angle), 16, 1);
+        let o = Overrides {
+            method: Some(Method::Vcm),
+            passes: Some(16),
+            ..Overrides::default()
+        };
+        let img = sum_layers(&render_uncached(&scene, &o, None), |_| true);
+        let (rel, se, sd) = relative_stats(&img, &all_pixels(&scene), floor_radiance());
+        eprintln!("{name} over a plane, vcm: mean {rel:.5} off, se {se:.5}, pixel sd {sd:.5}");
+        assert!(rel < 4.0 * se + 0.005, "{name}: mean {rel} off, se {se}");
+    }
+}

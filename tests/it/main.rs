@@ -72,3 +72,4 @@ mod shards;
 mod splat;
 mod sppm;
 mod textures;
+mod vcm;

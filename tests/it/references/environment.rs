@@ -125,3 +125,21 @@ fn light_tracing_matches_mitsuba_under_the_sky() {
     let bad = misfits(&img, &regs, &ENV_LIGHT_4);
     assert!(bad.is_empty(), "{bad:#?}");
 }
+
+/// Vertex connection and merging, 16 passes, over seeds 1-6, every region: TABLE_ENV
+const ENV_VCM_16: Measured<7> = Measured {
+    bias: [0.0; 7],
+    sd: [0.01; 7],
+};
+
+/// The sky-lit scene by vertex connection and merging against Mitsuba's path tracer: every
+/// region, the sky and the glass seen directly and the sun's caustic included (a light at
+/// infinity's emission and NEE densities weigh its paths).
+#[test]
+fn vcm_matches_mitsuba_under_the_sky() {
+    let s = environment(super::table_seed(), |_| {});
+    let regs = environment_regions(&s);
+    eprintln!("vcm, 16:");
+    let bad = misfits(&image_by(&s, Method::Vcm, 16), &regs, &ENV_VCM_16);
+    assert!(bad.is_empty(), "{bad:#?}");
+}

@@ -89,3 +89,20 @@ fn a_glossy_receiver_matches_mitsuba() {
     );
     assert!(!bad.is_empty(), "the floor's glossy lobe is not resolved");
 }
+
+/// Vertex connection and merging, 16 passes, over seeds 1-6: TABLE_GL
+const GLOSSY_VCM_16: Measured = Measured {
+    bias: [0.0; 7],
+    sd: [0.01; 7],
+};
+
+/// The glossy floor by vertex connection and merging against Mitsuba: every region, the
+/// caustic on the glossy floor included (its GGX lobe weighs connections and merging there).
+#[test]
+fn vcm_matches_mitsuba_on_a_glossy_receiver() {
+    let s = glossy(super::table_seed(), |_| {});
+    let regs = glossy_regions(&s);
+    eprintln!("vcm, 16:");
+    let bad = misfits(&image_by(&s, Method::Vcm, 16), &regs, &GLOSSY_VCM_16);
+    assert!(bad.is_empty(), "{bad:#?}");
+}

@@ -155,15 +155,25 @@ fn misfits<const N: usize>(img: &Image, regions: &[RegionRef], m: &Measured<N>) 
 }
 
 /// One image of `s` by `method` at `count` samples per pixel (path, path+splat) or passes
-/// (SPPM).
+/// (SPPM, VCM).
 fn image_by(s: &Scene, method: Method, count: u32) -> Image {
+    let passes = matches!(method, Method::Sppm | Method::Vcm);
     let o = Overrides {
         method: Some(method),
-        spp: (method != Method::Sppm).then_some(count),
-        passes: (method == Method::Sppm).then_some(count),
+        spp: (!passes).then_some(count),
+        passes: passes.then_some(count),
         ..Overrides::default()
     };
     sum_layers(&render_uncached(s, &o, None), |_| true)
+}
+
+/// The seed of the runs whose tables are re-measured by running their tests with
+/// `PHOTONFLOW_TABLE_SEED` set to 1, ..., 6 (the figures in the tables' comments); 1 else.
+fn table_seed() -> u64 {
+    std::env::var("PHOTONFLOW_TABLE_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1)
 }
 
 /// The light tracer's run of `s`: `passes` passes of `photons` paths.

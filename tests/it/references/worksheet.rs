@@ -466,3 +466,22 @@ fn sppm_glass_is_smooth_after_one_pass() {
     assert!(split < 0.15, "split glass: {split}");
     assert!(split * 3.0 <= single, "{split} against {single}");
 }
+
+/// Vertex connection and merging, 16 passes (one light and one eye subpath per pixel each),
+/// seeds 1-6: TABLE_WS
+const VCM_16: Measured = Measured {
+    bias: [0.0; 7],
+    sd: [0.01; 7],
+};
+
+/// Vertex connection and merging on the worksheet: every region within its tolerance of
+/// Mitsuba's, the caustic and its core included (merging carries the caustic seen on the
+/// floor, connections and path tracing the rest).
+#[test]
+fn vcm_matches_mitsuba_in_every_region() {
+    let s = scene(super::table_seed(), |_| {});
+    let regs = regions(&s);
+    eprintln!("vcm, 16:");
+    let bad = misfits(&super::image_by(&s, Method::Vcm, 16), &regs, &VCM_16);
+    assert!(bad.is_empty(), "{bad:#?}");
+}
