@@ -58,6 +58,26 @@ fn triangles(n: usize) -> Option<Check> {
     }))
 }
 
+/// A case whose MTL gives the floor's material `white` `lines` instead of `Kd 0.5 0.5 0.5`,
+/// run through `info`: refused with `words`, or, with none, loaded and checked by `check`.
+fn white(
+    name: &'static str,
+    lines: &str,
+    words: &'static [&'static str],
+    check: Option<Check>,
+) -> Case {
+    Case {
+        name,
+        files: files(scene(""), OBJ, &MTL.replace("Kd 0.5 0.5 0.5", lines)),
+        setup: vec![],
+        prepare: None,
+        args: "info {d}/s.toml",
+        code: if words.is_empty() { 0 } else { 1 },
+        words,
+        check,
+    }
+}
+
 fn cases() -> Vec<Case> {
     let black = MTL.replace("Kd 0.5 0.5 0.5", "Kd 0 0 0");
     let mirror = MTL.replace("Kd 0.5 0.5 0.5", "illum 3\nKs 0.9 0.9 0.9");
@@ -291,6 +311,31 @@ fn cases() -> Vec<Case> {
             words: &[],
             check: present("out/plan.txt", "no surface is diffuse"),
         },
+        // Values checked and named, never dropped.
+        white(
+            "MTL illum -1",
+            "Kd 0.5 0.5 0.5\nillum -1",
+            &["m.mtl", "line 3", "`illum -1`", "s.toml"],
+            None,
+        ),
+        white(
+            "MTL colour in words",
+            "Kd bright white",
+            &[
+                "m.mtl",
+                "line 2",
+                "`Kd bright white`",
+                "not a number",
+                "s.toml",
+            ],
+            None,
+        ),
+        white(
+            "MTL Ns in words",
+            "Kd 0.5 0.5 0.5\nKs 0.5 0.5 0.5\nNs high\nillum 2",
+            &["m.mtl", "line 4", "`Ns high`", "not a number", "s.toml"],
+            None,
+        ),
     ]
 }
 

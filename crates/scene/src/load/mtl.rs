@@ -30,34 +30,78 @@ use crate::material::ALPHA_RANGE;
 use crate::material::Material;
 use glam::Vec3;
 
-/// MTL colours (`Ka`, `Kd`, `Ks`, `Ke`, `Tf`) given with one number are grey, a variant real
-/// MTL files use: written out as three numbers here, since tobj panics on fewer than three.
-/// Two numbers or none is an error naming the line.
-pub(super) fn grey_colours(bytes: &[u8]) -> Result<Vec<u8>, String> {
+/// The MTL text checked line by line before tobj reads it: a value tobj cannot parse (it
+/// says only "material parse error") is refused here naming its line and text. Colours
+/// (`Ka`, `Kd`, `Ks`, `Ke`, `Tf`) given with one number are grey, a variant real MTL files
+/// use: written out as three numbers here, since tobj panics on fewer than three. Two
+/// numbers or none is an error naming the line.
+pub(super) fn prescan(bytes: &[u8]) -> Result<Vec<u8>, String> {
     let Ok(text) = std::str::from_utf8(bytes) else {
         return Err("not UTF-8 text".into());
     };
     let mut out = String::with_capacity(text.len() + 64);
     for (i, line) in text.split_inclusive('\n').enumerate() {
+        let n = i + 1;
         let mut words = line.split_whitespace();
-        let key = words.next();
-        if let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke" | "Tf")) = key {
-            let args: Vec<&str> = words.collect();
-            let numbers = args.iter().take_while(|w| w.parse::<f32>().is_ok()).count();
-            match (args.as_slice(), numbers) {
-                ([v], 1) => {
-                    out.push_str(&format!("{key} {v} {v} {v}\n"));
-                    continue;
+        let Some(key) = words.next() else {
+            out.push_str(line);
+            continue;
+        };
+        let args: Vec<&str> = words.collect();
+        let is_number = |w: &&str| w.parse::<f32>().is_ok();
+        let not_a_number = |w: &str, hint: &str| {
+            Err(format!(
+                "line {n}: `{}`: `{w}` is not a number{hint}",
+                line.trim()
+            ))
+        };
+        match key {
+            "Ka" | "Kd" | "Ks" | "Ke" | "Tf" => {
+                if let Some(w) = args.iter().take(3).find(|w| !is_number(w)) {
+                    let hint = if matches!(args.first(), Some(&("spectral" | "xyz"))) {
+                        " (the spectral and xyz forms are not read: give RGB)"
+                    } else {
+                        ""
+                    };
+                    return not_a_number(w, hint);
                 }
-                ([], _) | ([_, _], 2) => {
-                    return Err(format!(
-                        "line {}: `{key}` needs one number (grey) or three (RGB), got {}",
-                        i + 1,
-                        args.len()
-                    ));
+                match args.as_slice() {
+                    [v] => {
+                        out.push_str(&format!("{key} {v} {v} {v}\n"));
+                        continue;
+                    }
+                    [] | [_, _] => {
+                        return Err(format!(
+                            "line {n}: `{key}` needs one number (grey) or three (RGB), got {}",
+                            args.len()
+                        ));
+                    }
+                    _ => {}
                 }
-                _ => {}
             }
+            // tobj reads the first word of these as a number and ignores the rest.
+            "Ns" | "Ni" | "d" | "Tr" => match args.first() {
+                None => return Err(format!("line {n}: `{key}` needs a number")),
+                Some(w) if !is_number(w) => return not_a_number(w, ""),
+                Some(_) => {}
+            },
+            "illum" if args.first().is_none_or(|w| w.parse::<u8>().is_err()) => {
+                return Err(format!(
+                    "line {n}: `{}`: the illumination model must be a whole number (the MTL \
+                     spec's 0-10, the course's 11)",
+                    line.trim()
+                ));
+            }
+            "newmtl" if args.is_empty() => {
+                return Err(format!("line {n}: `newmtl` needs a material name"));
+            }
+            "map_Ka" | "map_Kd" | "map_Ks" | "map_Bump" | "map_bump" | "map_Ns" | "map_ns"
+            | "map_NS" | "bump" | "map_d"
+                if args.is_empty() =>
+            {
+                return Err(format!("line {n}: `{key}` needs an image file name"));
+            }
+            _ => {}
         }
         out.push_str(line);
     }

@@ -3,7 +3,7 @@
 //! texture coordinates kept, every problem named with its file and line.
 
 use super::Builder;
-use super::mtl::{convert_mtl, grey_colours};
+use super::mtl::{convert_mtl, prescan};
 use super::transform::transform;
 use super::{MAX_COORD, read_regular};
 use crate::error::SceneError;
@@ -51,7 +51,7 @@ impl Builder<'_> {
         Ok(())
     }
 
-    /// Reads the OBJ file and the MTL files it names (each through [`grey_colours`]).
+    /// Reads the OBJ file and the MTL files it names (each through [`prescan`]).
     fn parse_obj(
         &mut self,
         index: usize,
@@ -94,7 +94,7 @@ impl Builder<'_> {
                     Ok(b) => {
                         mtl_bytes.borrow_mut().extend_from_slice(&b);
                         mtl_files.borrow_mut().push(p.display().to_string());
-                        let b = match grey_colours(&b) {
+                        let b = match prescan(&b) {
                             Ok(b) => b,
                             Err(problem) => {
                                 *mtl_error.borrow_mut() = Some(SceneError::new(
