@@ -113,6 +113,20 @@ fn present(rel: &'static str, holds: &'static str) -> Option<Check> {
     }))
 }
 
+/// The case's `s.toml` loads, with a warning that holds every one of `words`.
+fn warns(words: &'static [&'static str]) -> Option<Check> {
+    Some(Box::new(move |d: &Path| {
+        let s = scene::Scene::load(d.join("s.toml")).unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            s.warnings
+                .iter()
+                .any(|w| words.iter().all(|x| w.contains(x))),
+            "no warning holds {words:?}: {:?}",
+            s.warnings
+        );
+    }))
+}
+
 /// A case whose scene adds one `[[light]]` (`light`, TOML) beside `extra` files, refused at
 /// loading with `words`; the render writes nothing.
 fn light_case(

@@ -313,6 +313,46 @@ fn cases() -> Vec<Case> {
         },
         // Values checked and named, never dropped.
         white(
+            "MTL Ni NaN on glass",
+            "illum 7\nNi nan",
+            &[
+                "m.mtl",
+                "material `white`",
+                "`Ni NaN`",
+                "index of refraction",
+            ],
+            None,
+        ),
+        white(
+            "MTL Ni negative on glass",
+            "illum 4\nNi -1.5",
+            &[
+                "m.mtl",
+                "material `white`",
+                "`Ni -1.5`",
+                "index of refraction",
+            ],
+            None,
+        ),
+        white(
+            "MTL Ni 0 on glass, the exporters' unset",
+            "illum 7\nNi 0",
+            &[],
+            warns(&["m.mtl: material `white`", "`Ni 0`", "index 1.5"]),
+        ),
+        white(
+            "MTL Ks negative with illum 2",
+            "Kd 0.5 0.5 0.5\nKs -0.5 -0.5 -0.5\nNs 10\nillum 2",
+            &["m.mtl", "material `white`", "`Ks -0.5 -0.5 -0.5`", ">= 0"],
+            None,
+        ),
+        white(
+            "MTL Ks NaN with illum 2",
+            "Kd 0.5 0.5 0.5\nKs nan 0.5 0.5\nNs 10\nillum 2",
+            &["m.mtl", "material `white`", "`Ks NaN 0.5 0.5`", ">= 0"],
+            None,
+        ),
+        white(
             "MTL illum -1",
             "Kd 0.5 0.5 0.5\nillum -1",
             &["m.mtl", "line 3", "`illum -1`", "s.toml"],

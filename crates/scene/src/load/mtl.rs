@@ -11,13 +11,14 @@
 //! | `illum 0`, `1`, no `illum` | Lambertian `Kd` (a `Ks` there is not drawn: warning) |
 //! | `illum 2` | Lambertian `Kd`, plus with `Ks > 0` a GGX lobe of constant reflectance `Ks` (no Fresnel) of roughness α = √(2 / (`Ns` + 2)) (Walter et al. 2007); where `Kd + Ks` exceeds 1 in a channel both are scaled there to sum to 1 (warning) |
 //! | `illum 3`, `5`, `8` | mirror of reflectance `Ks` (1 where `Ks` is absent or black); illum 5's Fresnel term and illum 8's "ray trace off" are not modelled, nor a `Kd` beside the mirror (warnings) |
-//! | `illum 4`, `6`, `7`, `9` | glass of index `Ni` and transmittance `Tf`, exact Fresnel reflection and refraction (index 1.5 where `Ni` is absent or <= 1, and illum 6's and 9's variants: warnings) |
+//! | `illum 4`, `6`, `7`, `9` | glass of index `Ni` and transmittance `Tf`, exact Fresnel reflection and refraction (index 1.5 where `Ni` is absent or in [0, 1], and illum 6's and 9's variants: warnings; a negative or NaN `Ni` is refused) |
 //! | `illum 10` | refused (shadow matte) |
 //! | `illum 11` | the course's metal: constant reflectance `Ks` |
 //! | `d < 1`, `Tr > 0` | glass (illum 4, 6, 7, 9, or the course's illum 0-2 with `Ni > 1`); refused on any other surface |
 //! | `Ke` | emitted radiance (`emission = "ke"`, the default) |
 //! | `Ka` | emitted radiance with `[[mesh]] emission = "ka"` (the course's convention; a material with `Ke` too is refused); otherwise the ambient colour, which a physically based renderer does not use |
 //! | `Ni` | the index of refraction of glass; not read elsewhere |
+//! | `Ks` | the specular colour of illum 2, 3, 5, 8 and 11 (above; elsewhere: warning); negative or NaN in a channel, refused whatever the `illum` |
 //! | `Tf` | on glass, its transmittance: a factor on refracted light at every crossing, each channel in [0, 1] (refused outside it); warning elsewhere. Absorption inside glass has no MTL key: use the scene file's `absorption` |
 //! | `map_Kd` | the diffuse albedo's texture, times `Kd` (the MTL spec's product; the texture alone where `Kd` is absent): PNG, JPEG, TGA or EXR, relative to the MTL file; 8-bit and 16-bit images are sRGB-decoded, EXR is linear; read at the OBJ's `vt` (without them, at each triangle's barycentrics: warning), bilinear, repeated. On illum 0-2 only (elsewhere: warning, drawn without). A missing or unreadable image, or texture options (`-s`, `-o`, ...), are refused |
 //! | `map_Ks`, `map_d` | refused (of the texture maps only `map_Kd` is rendered) |
@@ -287,6 +288,14 @@ pub(super) fn convert_mtl(
              glass (illum 4, 6, 7 or 9 with `Ni`)"
         ));
     }
+    // Checked before the model is chosen: a negative or NaN `Ks` would otherwise fail
+    // `Ks > 0` and draw a Lambertian surface without a word.
+    if let Some(k) = ks_given.filter(|k| !(k.is_finite() && k.min_element() >= 0.0)) {
+        return Err(format!(
+            "`Ks {} {} {}`: the specular reflectance must be a number >= 0 in each channel",
+            k.x, k.y, k.z
+        ));
+    }
     let glassy = glass_illum || course_glass;
     if glassy && tf.is_some_and(|t| !in_unit(t)) {
         return Err(format!(
@@ -301,7 +310,7 @@ pub(super) fn convert_mtl(
         ));
     }
     let mat = match illum {
-        _ if course_glass => glass(&mut warnings, "", m, tf),
+        _ if course_glass => glass(&mut warnings, "", m, tf)?,
         Some(2) if ks.max_element() > 0.0 => {
             let ns = m.shininess.unwrap_or(0.0);
             if !(ns.is_finite() && ns >= 0.0) {
@@ -351,20 +360,20 @@ pub(super) fn convert_mtl(
             m,
             kd,
         ),
-        Some(4 | 7) => glass(&mut warnings, "", m, tf),
+        Some(4 | 7) => glass(&mut warnings, "", m, tf)?,
         Some(6) => glass(
             &mut warnings,
             "illum 6 (refraction, Fresnel off): drawn as glass with Fresnel reflection",
             m,
             tf,
-        ),
+        )?,
         Some(9) => glass(
             &mut warnings,
             "illum 9 (glass without ray-traced reflection): drawn as glass with Fresnel \
              reflection",
             m,
             tf,
-        ),
+        )?,
         Some(10) => {
             return Err(
                 "illum 10 (a shadow matte: shadows cast onto invisible surfaces) \
@@ -414,9 +423,15 @@ fn mirror(warnings: &mut Vec<String>, why: &str, m: &tobj::Material, kd: Vec3) -
     Material::Mirror { reflectance }
 }
 
-/// Glass of index `Ni` (1.5 where absent or not above 1: warning) and transmittance `tf`,
-/// with `why` (if not empty) and an unused `Ks` warned about.
-fn glass(warnings: &mut Vec<String>, why: &str, m: &tobj::Material, tf: Option<Vec3>) -> Material {
+/// Glass of index `Ni` (1.5 where absent or in [0, 1]: warning; refused where negative or
+/// not a number) and transmittance `tf`, with `why` (if not empty) and an unused `Ks` warned
+/// about.
+fn glass(
+    warnings: &mut Vec<String>,
+    why: &str,
+    m: &tobj::Material,
+    tf: Option<Vec3>,
+) -> Result<Material, String> {
     let ni = m.optical_density;
     let ks_given = m.specular.map(Vec3::from);
     let ks = ks_given.unwrap_or(Vec3::ZERO);
@@ -425,6 +440,13 @@ fn glass(warnings: &mut Vec<String>, why: &str, m: &tobj::Material, tf: Option<V
     }
     let ior = match ni {
         Some(n) if n > 1.0 => n,
+        // Exporters write `Ni 0` for "unset"; a negative or NaN index is no such convention.
+        Some(n) if n.is_nan() || n < 0.0 => {
+            return Err(format!(
+                "`Ni {n}`: the index of refraction of glass must be a number above 1 (0, which \
+                 exporters write for unset, is drawn as 1.5)"
+            ));
+        }
         _ => {
             warnings.push(format!(
                 "glass without an index above 1 (`Ni {}`): drawn with index 1.5",
@@ -441,9 +463,9 @@ fn glass(warnings: &mut Vec<String>, why: &str, m: &tobj::Material, tf: Option<V
     }
     // `Tf` scales refracted light at every crossing: Mitsuba 3's
     // `specular_transmittance`, which the peers' mapping gives it too.
-    Material::Dielectric {
+    Ok(Material::Dielectric {
         ior,
         transmittance: tf.unwrap_or(Vec3::ONE),
         absorption: Vec3::ZERO,
-    }
+    })
 }
