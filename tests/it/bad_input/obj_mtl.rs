@@ -376,6 +376,39 @@ fn cases() -> Vec<Case> {
             &["m.mtl", "line 4", "`Ns high`", "not a number", "s.toml"],
             None,
         ),
+        white(
+            "MTL d and a disagreeing Tr",
+            "Kd 0.5 0.5 0.5\nd 1.0\nTr 0.5",
+            &[],
+            warns(&[
+                "m.mtl: material `white`",
+                "`d 1`",
+                "`Tr 0.5`",
+                "`d` is used",
+            ]),
+        ),
+        Case {
+            name: "MTL material defined twice",
+            files: files(
+                scene(""),
+                OBJ,
+                &format!("{MTL}newmtl white\nKd 0.2 0.2 0.2\n"),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 0,
+            words: &[],
+            check: Some(Box::new(|d: &Path| {
+                warns(&["m.mtl: material `white`", "defined 2 times", "the last"]).unwrap()(d);
+                let s = scene::Scene::load(d.join("s.toml")).unwrap();
+                let id = s.material_of("white").unwrap() as usize;
+                let want = scene::Material::Lambertian {
+                    albedo: glam::Vec3::splat(0.2),
+                };
+                assert_eq!(s.materials[id], want, "not the last definition");
+            })),
+        },
     ]
 }
 

@@ -14,7 +14,8 @@
 //! | `illum 4`, `6`, `7`, `9` | glass of index `Ni` and transmittance `Tf`, exact Fresnel reflection and refraction (index 1.5 where `Ni` is absent or in [0, 1], and illum 6's and 9's variants: warnings; a negative or NaN `Ni` is refused) |
 //! | `illum 10` | refused (shadow matte) |
 //! | `illum 11` | the course's metal: constant reflectance `Ks` |
-//! | `d < 1`, `Tr > 0` | glass (illum 4, 6, 7, 9, or the course's illum 0-2 with `Ni > 1`); refused on any other surface |
+//! | `d < 1`, `Tr > 0` | glass (illum 4, 6, 7, 9, or the course's illum 0-2 with `Ni > 1`); refused on any other surface. `d` and `Tr` both given and disagreeing (`Tr` is 1 - `d`): `d` is used (warning) |
+//! | `newmtl` of a name defined before | the last definition is used, as other loaders do (warning) |
 //! | `Ke` | emitted radiance (`emission = "ke"`, the default) |
 //! | `Ka` | emitted radiance with `[[mesh]] emission = "ka"` (the course's convention; a material with `Ke` too is refused); otherwise the ambient colour, which a physically based renderer does not use |
 //! | `Ni` | the index of refraction of glass; not read elsewhere |
@@ -197,6 +198,13 @@ fn read_keys(m: &tobj::Material, emission: EmissionSource) -> Result<Keys, Strin
         None => None,
     };
     let opacity = m.dissolve.or(tr.map(|t| 1.0 - t)).unwrap_or(1.0);
+    if let (Some(d), Some(t)) = (m.dissolve, tr)
+        && (d - (1.0 - t)).abs() > 1e-3
+    {
+        warnings.push(format!(
+            "`d {d}` and `Tr {t}` disagree (`Tr` is 1 - `d`): `d` is used, opacity {d}"
+        ));
+    }
     if !(0.0..=1.0).contains(&opacity) {
         return Err(format!("`d`/`Tr`: opacity {opacity} must lie in [0, 1]"));
     }

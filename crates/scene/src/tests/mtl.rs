@@ -189,6 +189,15 @@ fn mtl_files_follow_the_documented_table() {
         "glass reflects by the Fresnel",
     );
     assert_eq!(quiet("Ni 1.5\nTr 0.9\nillum 7"), Material::glass(1.5));
+    // `d` and `Tr` both: `d` is used, with a warning where they disagree.
+    assert_eq!(
+        quiet("Ni 1.5\nd 0.1\nTr 0.9\nillum 7"),
+        Material::glass(1.5)
+    );
+    assert_eq!(
+        warned("Kd 0.5 0.5 0.5\nd 1\nTr 0.5", "`d` is used"),
+        Material::Lambertian { albedo: v(0.5) }
+    );
     // Course metal.
     assert_eq!(
         quiet("Ks 0.96 0.98 0.96\nillum 11"),
