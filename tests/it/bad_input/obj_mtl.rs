@@ -377,6 +377,12 @@ fn cases() -> Vec<Case> {
             None,
         ),
         white(
+            "MTL Kd above 1",
+            "Kd 2 2 2",
+            &["m.mtl: material `white`: `Kd` = [2, 2, 2] must lie in [0, 1]"],
+            None,
+        ),
+        white(
             "MTL d and a disagreeing Tr",
             "Kd 0.5 0.5 0.5\nd 1.0\nTr 0.5",
             &[],

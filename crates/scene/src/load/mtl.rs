@@ -26,7 +26,7 @@
 //! | `bump`, `map_Bump`, `map_Ns`, `refl`, `disp`, `decal` | warning: drawn without |
 //! | `Pr`, `Pm`, `Ps`, `Pc`, `Pcr`, `aniso`, `anisor`, `map_Pr`, `map_Pm` (the PBR extension) | refused |
 
-use super::materials::in_unit;
+use super::materials::{check, in_unit};
 use crate::file::EmissionSource;
 use crate::material::ALPHA_RANGE;
 use crate::material::Material;
@@ -398,6 +398,17 @@ pub(super) fn convert_mtl(
             ));
         }
     };
+    check(&mat, |k| {
+        match k {
+            "albedo" => "`Kd`",
+            "specular" | "reflectance" => "`Ks`",
+            "ior" => "`Ni`",
+            "transmittance" => "`Tf`",
+            "alpha" => "alpha (from `Ns`)",
+            other => other,
+        }
+        .to_string()
+    })?;
     Ok(Converted {
         material: mat,
         emission: e,
