@@ -415,6 +415,25 @@ fn cases() -> Vec<Case> {
                 assert_eq!(s.materials[id], want, "not the last definition");
             })),
         },
+        // A texture brighter than 1 under a diffuse albedo.
+        Case {
+            name: "MTL map_Kd above 1 under a Lambertian Kd",
+            files: with(
+                files(
+                    scene(""),
+                    OBJ,
+                    &MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.7 0.7 0.7\nmap_Kd t.exr"),
+                ),
+                "t.exr",
+                Input::Exr(Image::from_fn(2, 2, |_, _| [4.0; 3])),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 0,
+            words: &[],
+            check: texture_scaled(&["m.mtl: material `white`", "brightest texel", "exceeds 1"]),
+        },
     ]
 }
 

@@ -311,6 +311,27 @@ fn cases() -> Vec<Case> {
             "type = \"rough_conductor\"\nalpha = 0.1\neta = [1, 1, 1]",
             &["s.toml: material `white`: eta and k", "k is missing"],
         ),
+        // A texture brighter than 1 under a diffuse albedo.
+        Case {
+            name: "lambertian albedo x texture above 1",
+            files: with(
+                files(
+                    scene(
+                        "[material.white]\ntype = \"lambertian\"\nalbedo = [0.7, 0.7, 0.7]\ntexture = \"t.exr\"\n",
+                    ),
+                    OBJ,
+                    MTL,
+                ),
+                "t.exr",
+                Input::Exr(film::Image::from_fn(2, 2, |_, _| [4.0; 3])),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 0,
+            words: &[],
+            check: texture_scaled(&["s.toml: material `white`", "brightest texel", "exceeds 1"]),
+        },
     ]
 }
 

@@ -12,6 +12,11 @@ use crate::texture::Texture;
 use glam::Vec3;
 use std::path::Path;
 
+/// How an MTL file names a material's albedo, its texture and its specular reflectance.
+pub(super) const MTL_KEYS: [&str; 3] = ["`Kd`", "`map_Kd`", "`Ks`"];
+/// How the scene file names them.
+const FILE_KEYS: [&str; 3] = ["albedo", "texture", "specular"];
+
 /// A scene-file material and its emission.
 pub(super) fn of_desc(desc: &MaterialDesc) -> (Material, Vec3) {
     match desc {
@@ -124,35 +129,59 @@ impl Builder<'_> {
 
     /// Gives material `id` the albedo texture at `path`, the material's own albedo becoming
     /// the texture's scale. Only materials with a diffuse lobe take one; for the others the
-    /// texture is not drawn. `Ok` holds a warning, if any; `Err` the problem with the image.
+    /// texture is not drawn. Where the albedo times the brightest texel (plus the specular
+    /// reflectance) exceeds 1 in a channel, the material is scaled there to 1: no point
+    /// reflects more than it gets. `keys` names the albedo, the texture and the specular
+    /// reflectance in messages ([`MTL_KEYS`], [`FILE_KEYS`]). `Ok` holds a warning, if any;
+    /// `Err` the problem with the image.
     pub(super) fn attach_albedo_map(
         &mut self,
         id: u32,
         path: &Path,
+        keys: [&str; 3],
     ) -> Result<Option<String>, String> {
+        let [kd, map, ks] = keys;
         let Some(m) = self.materials.get(id as usize).cloned() else {
             return Err(format!("internal error: material id {id}"));
         };
         let texture = self.texture(path)?;
+        let t_max = self
+            .textures
+            .get(texture as usize)
+            .map_or(Vec3::ONE, Texture::max);
+        // The factor per channel that brings `peak` down to 1 where it exceeds it.
+        let to_one = |peak: Vec3| Vec3::select(peak.cmpgt(Vec3::ONE), peak.recip(), Vec3::ONE);
         let mut warning = None;
         let scale = match m {
-            Material::Lambertian { albedo } => albedo,
+            Material::Lambertian { albedo } => {
+                // An HDR texture may hold texels far above 1 (an EXR of 4 under `Kd 0.7`
+                // reflected 2.8 times the light it got).
+                let peak = albedo * t_max;
+                let f = to_one(peak);
+                if f != Vec3::ONE {
+                    warning = Some(format!(
+                        "{kd} x {map}'s brightest texel exceeds 1 in a channel ({} {} {}): {kd} \
+                         scaled there so that texel reflects 1",
+                        peak.x, peak.y, peak.z
+                    ));
+                    if let Some(mat) = self.materials.get_mut(id as usize) {
+                        *mat = Material::Lambertian { albedo: albedo * f };
+                    }
+                }
+                albedo * f
+            }
             Material::Glossy {
                 albedo,
                 specular,
                 alpha,
             } => {
                 // The untextured rule (`Kd + Ks <= 1` per channel, both scaled there where
-                // not) over the texture's brightest texel: no point reflects more than it gets.
-                let t_max = self
-                    .textures
-                    .get(texture as usize)
-                    .map_or(Vec3::ONE, Texture::max);
+                // not) over the texture's brightest texel.
                 let sum = albedo * t_max + specular;
-                let f = Vec3::select(sum.cmpgt(Vec3::ONE), sum.recip(), Vec3::ONE);
+                let f = to_one(sum);
                 if f != Vec3::ONE {
                     warning = Some(format!(
-                        "`Kd` x `map_Kd`'s brightest texel + `Ks` exceeds 1 in a channel ({} {} \
+                        "{kd} x {map}'s brightest texel + {ks} exceeds 1 in a channel ({} {} \
                          {}): both scaled there to sum to 1",
                         sum.x, sum.y, sum.z
                     ));
@@ -168,7 +197,7 @@ impl Builder<'_> {
             }
             _ => {
                 return Ok(Some(format!(
-                    "`map_Kd {}`: only diffuse and glossy (illum 0-2) materials are textured; \
+                    "{map} ({}): only diffuse and glossy (illum 0-2) materials are textured; \
                      this one is drawn without it",
                     path.display()
                 )));
@@ -228,7 +257,7 @@ impl Builder<'_> {
             };
             let image = self.dir.join(t);
             let id = self.by_name.get(name).copied().unwrap_or(u32::MAX);
-            let warned = self.attach_albedo_map(id, &image).map_err(|p| {
+            let warned = self.attach_albedo_map(id, &image, FILE_KEYS).map_err(|p| {
                 self.err(format!(
                     "material `{name}`: texture `{t}` ({}): {p}",
                     image.display()
