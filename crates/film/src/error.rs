@@ -39,6 +39,8 @@ pub enum FilmError {
     EmptyRegion,
     /// Bias and variance apart need at least two independent runs.
     TooFewRuns { runs: usize },
+    /// A reference's two halves that are one image: they estimate no noise.
+    IdenticalHalves,
     /// A file of f64 sums ([`crate::read_sums`]) that is not one, or is damaged.
     Sums { path: PathBuf, problem: String },
 }
@@ -72,6 +74,11 @@ impl fmt::Display for FilmError {
             Self::TooFewRuns { runs } => write!(
                 f,
                 "bias and variance need at least two independent runs, got {runs}"
+            ),
+            Self::IdenticalHalves => write!(
+                f,
+                "the reference's two halves are identical pixel for pixel: there is no noise to \
+                 take out (the second half is a render with another seed)"
             ),
             Self::Sums { path, problem } => write!(f, "{}: {problem}", path.display()),
         }

@@ -16,9 +16,13 @@ pub struct Halves {
 }
 
 impl Halves {
-    /// The halves `a` and `b` (same size, independent seeds).
+    /// The halves `a` and `b` (same size, independent seeds). Two equal images are refused:
+    /// one file given twice would estimate no noise and take nothing out.
     pub fn new(a: &Image, b: &Image) -> Result<Halves, FilmError> {
         a.check_same_size(b, "reference halves")?;
+        if a.data == b.data {
+            return Err(FilmError::IdenticalHalves);
+        }
         let mut variance = Vec::with_capacity(a.data.len());
         let mean = Image::from_fn(a.width, a.height, |x, y| {
             let (pa, pb) = (a.get(x, y), b.get(x, y));

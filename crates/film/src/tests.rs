@@ -749,6 +749,11 @@ fn halves_take_the_references_noise_out_of_the_errors() {
     let img = noisy(sigma, &|x| if x < w / 2 { bias } else { 0.0 });
     let truth = constant(w, h, 1.0);
     let halves = Halves::new(&a, &b).unwrap();
+    // One image given as both halves estimates no noise: refused.
+    assert!(matches!(
+        Halves::new(&a, &a.clone()),
+        Err(FilmError::IdenticalHalves)
+    ));
     let against_truth = metrics(&img, &truth, None).unwrap();
     let m = metrics_halves(&img, &halves, None).unwrap();
     // Against the truth: MSE = sigma² + bias²/2 = 0.0025 + 0.00045 = 0.00295.

@@ -201,6 +201,34 @@ fn cases() -> Vec<Case> {
             words: &["ref.exr", "reference is 16x8"],
             check: absent("out"),
         },
+        // A reference's halves that are one image.
+        Case {
+            name: "compare A B B",
+            files: vec![
+                ("a.exr", Input::Exr(grey(16, 16))),
+                ("b.exr", Input::Exr(grey(16, 16))),
+            ],
+            setup: vec![],
+            prepare: None,
+            args: "compare {d}/a.exr {d}/b.exr {d}/b.exr",
+            code: 1,
+            words: &["b.exr and", "identical", "no noise to take out"],
+            check: None,
+        },
+        Case {
+            name: "compare A B C with C a copy of B",
+            files: vec![
+                ("a.exr", Input::Exr(grey(16, 16))),
+                ("b.exr", Input::Exr(grey(16, 16))),
+                ("c.exr", Input::Exr(grey(16, 16))),
+            ],
+            setup: vec![],
+            prepare: None,
+            args: "compare {d}/a.exr {d}/b.exr {d}/c.exr",
+            code: 1,
+            words: &["b.exr and", "c.exr", "identical", "no noise to take out"],
+            check: None,
+        },
     ]
 }
 

@@ -272,6 +272,25 @@ fn cases() -> Vec<Case> {
             words: &["s.toml: the scene has no light"],
             check: absent("out"),
         },
+        // Positions within the range vertices have.
+        light_case(
+            "a point light at 1e20",
+            "type = \"point\"\nposition = [1e20, 1, 0]\nintensity = [1, 1, 1]",
+            vec![],
+            &[
+                "s.toml: light 0 (point): position [1e20, 1.0, 0.0]",
+                "1e15 scene units",
+            ],
+        ),
+        light_case(
+            "a spot aimed at 1e20",
+            "type = \"spot\"\nposition = [0, 1, 0]\nlook_at = [0, -1e20, 0]\nintensity = [1, 1, 1]",
+            vec![],
+            &[
+                "s.toml: light 0 (spot): look_at [0.0, -1e20, 0.0]",
+                "1e15 scene units",
+            ],
+        ),
     ]
 }
 

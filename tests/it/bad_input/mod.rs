@@ -113,6 +113,33 @@ fn present(rel: &'static str, holds: &'static str) -> Option<Check> {
     }))
 }
 
+/// The case's `s.toml` loads, with a warning that holds every one of `words`.
+fn warns(words: &'static [&'static str]) -> Option<Check> {
+    Some(Box::new(move |d: &Path| {
+        let s = scene::Scene::load(d.join("s.toml")).unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            s.warnings
+                .iter()
+                .any(|w| words.iter().all(|x| w.contains(x))),
+            "no warning holds {words:?}: {:?}",
+            s.warnings
+        );
+    }))
+}
+
+/// The case's `s.toml` loads; material `white`'s albedo texture, times its scale, peaks at 1
+/// at most in every channel, with a warning that holds every one of `words`.
+fn texture_scaled(words: &'static [&'static str]) -> Option<Check> {
+    Some(Box::new(move |d: &Path| {
+        warns(words).unwrap()(d);
+        let s = scene::Scene::load(d.join("s.toml")).unwrap_or_else(|e| panic!("{e}"));
+        let id = s.material_of("white").unwrap() as usize;
+        let map = s.albedo_maps[id].as_ref().expect("white has no texture");
+        let peak = map.scale * s.textures[map.texture as usize].max();
+        assert!(peak.max_element() <= 1.0 + 1e-6, "albedo peaks at {peak}");
+    }))
+}
+
 /// A case whose scene adds one `[[light]]` (`light`, TOML) beside `extra` files, refused at
 /// loading with `words`; the render writes nothing.
 fn light_case(

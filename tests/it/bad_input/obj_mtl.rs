@@ -58,6 +58,26 @@ fn triangles(n: usize) -> Option<Check> {
     }))
 }
 
+/// A case whose MTL gives the floor's material `white` `lines` instead of `Kd 0.5 0.5 0.5`,
+/// run through `info`: refused with `words`, or, with none, loaded and checked by `check`.
+fn white(
+    name: &'static str,
+    lines: &str,
+    words: &'static [&'static str],
+    check: Option<Check>,
+) -> Case {
+    Case {
+        name,
+        files: files(scene(""), OBJ, &MTL.replace("Kd 0.5 0.5 0.5", lines)),
+        setup: vec![],
+        prepare: None,
+        args: "info {d}/s.toml",
+        code: if words.is_empty() { 0 } else { 1 },
+        words,
+        check,
+    }
+}
+
 fn cases() -> Vec<Case> {
     let black = MTL.replace("Kd 0.5 0.5 0.5", "Kd 0 0 0");
     let mirror = MTL.replace("Kd 0.5 0.5 0.5", "illum 3\nKs 0.9 0.9 0.9");
@@ -290,6 +310,129 @@ fn cases() -> Vec<Case> {
             code: 0,
             words: &[],
             check: present("out/plan.txt", "no surface is diffuse"),
+        },
+        // Values checked and named, never dropped.
+        white(
+            "MTL Ni NaN on glass",
+            "illum 7\nNi nan",
+            &[
+                "m.mtl",
+                "material `white`",
+                "`Ni NaN`",
+                "index of refraction",
+            ],
+            None,
+        ),
+        white(
+            "MTL Ni negative on glass",
+            "illum 4\nNi -1.5",
+            &[
+                "m.mtl",
+                "material `white`",
+                "`Ni -1.5`",
+                "index of refraction",
+            ],
+            None,
+        ),
+        white(
+            "MTL Ni 0 on glass, the exporters' unset",
+            "illum 7\nNi 0",
+            &[],
+            warns(&["m.mtl: material `white`", "`Ni 0`", "index 1.5"]),
+        ),
+        white(
+            "MTL Ks negative with illum 2",
+            "Kd 0.5 0.5 0.5\nKs -0.5 -0.5 -0.5\nNs 10\nillum 2",
+            &["m.mtl", "material `white`", "`Ks -0.5 -0.5 -0.5`", ">= 0"],
+            None,
+        ),
+        white(
+            "MTL Ks NaN with illum 2",
+            "Kd 0.5 0.5 0.5\nKs nan 0.5 0.5\nNs 10\nillum 2",
+            &["m.mtl", "material `white`", "`Ks NaN 0.5 0.5`", ">= 0"],
+            None,
+        ),
+        white(
+            "MTL illum -1",
+            "Kd 0.5 0.5 0.5\nillum -1",
+            &["m.mtl", "line 3", "`illum -1`", "s.toml"],
+            None,
+        ),
+        white(
+            "MTL colour in words",
+            "Kd bright white",
+            &[
+                "m.mtl",
+                "line 2",
+                "`Kd bright white`",
+                "not a number",
+                "s.toml",
+            ],
+            None,
+        ),
+        white(
+            "MTL Ns in words",
+            "Kd 0.5 0.5 0.5\nKs 0.5 0.5 0.5\nNs high\nillum 2",
+            &["m.mtl", "line 4", "`Ns high`", "not a number", "s.toml"],
+            None,
+        ),
+        white(
+            "MTL Kd above 1",
+            "Kd 2 2 2",
+            &["m.mtl: material `white`: `Kd` = [2, 2, 2] must lie in [0, 1]"],
+            None,
+        ),
+        white(
+            "MTL d and a disagreeing Tr",
+            "Kd 0.5 0.5 0.5\nd 1.0\nTr 0.5",
+            &[],
+            warns(&[
+                "m.mtl: material `white`",
+                "`d 1`",
+                "`Tr 0.5`",
+                "`d` is used",
+            ]),
+        ),
+        Case {
+            name: "MTL material defined twice",
+            files: files(
+                scene(""),
+                OBJ,
+                &format!("{MTL}newmtl white\nKd 0.2 0.2 0.2\n"),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 0,
+            words: &[],
+            check: Some(Box::new(|d: &Path| {
+                warns(&["m.mtl: material `white`", "defined 2 times", "the last"]).unwrap()(d);
+                let s = scene::Scene::load(d.join("s.toml")).unwrap();
+                let id = s.material_of("white").unwrap() as usize;
+                let want = scene::Material::Lambertian {
+                    albedo: glam::Vec3::splat(0.2),
+                };
+                assert_eq!(s.materials[id], want, "not the last definition");
+            })),
+        },
+        // A texture brighter than 1 under a diffuse albedo.
+        Case {
+            name: "MTL map_Kd above 1 under a Lambertian Kd",
+            files: with(
+                files(
+                    scene(""),
+                    OBJ,
+                    &MTL.replace("Kd 0.5 0.5 0.5", "Kd 0.7 0.7 0.7\nmap_Kd t.exr"),
+                ),
+                "t.exr",
+                Input::Exr(Image::from_fn(2, 2, |_, _| [4.0; 3])),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 0,
+            words: &[],
+            check: texture_scaled(&["m.mtl: material `white`", "brightest texel", "exceeds 1"]),
         },
     ]
 }

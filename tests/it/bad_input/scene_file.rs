@@ -3,6 +3,21 @@
 
 use super::*;
 
+/// A case whose scene file gives material `white` (the floor's) as `body`, run through
+/// `info`: refused with `words`.
+fn material(name: &'static str, body: &str, words: &'static [&'static str]) -> Case {
+    Case {
+        name,
+        files: files(scene(&format!("[material.white]\n{body}\n")), OBJ, MTL),
+        setup: vec![],
+        prepare: None,
+        args: "info {d}/s.toml",
+        code: 1,
+        words,
+        check: None,
+    }
+}
+
 fn cases() -> Vec<Case> {
     let global = |extra: &str| scene(&format!("[estimate.global]\n{extra}\n"));
     vec![
@@ -224,6 +239,98 @@ fn cases() -> Vec<Case> {
             code: 1,
             words: &["s.toml: estimate.splat.splits = 99 is absurd (at most 16)"],
             check: absent("out"),
+        },
+        // Material keys, each named with its value.
+        material(
+            "glossy alpha = 0",
+            "type = \"glossy\"\nalbedo = [0.5, 0.5, 0.5]\nspecular = [0.2, 0.2, 0.2]\nalpha = 0",
+            &["s.toml: material `white`: alpha = 0 must be in [1e-4, 1]"],
+        ),
+        material(
+            "glossy alpha = 1e-5",
+            "type = \"glossy\"\nalbedo = [0.5, 0.5, 0.5]\nspecular = [0.2, 0.2, 0.2]\nalpha = 1e-5",
+            &["s.toml: material `white`: alpha = 0.00001 must be in [1e-4, 1]"],
+        ),
+        material(
+            "rough_conductor alpha = 1.0001",
+            "type = \"rough_conductor\"\nalpha = 1.0001",
+            &["s.toml: material `white`: alpha = 1.0001 must be in [1e-4, 1]"],
+        ),
+        material(
+            "rough_conductor alpha = -0.1",
+            "type = \"rough_conductor\"\nalpha = -0.1",
+            &["s.toml: material `white`: alpha = -0.1 must be in [1e-4, 1]"],
+        ),
+        material(
+            "rough_dielectric alpha = NaN",
+            "type = \"rough_dielectric\"\nior = 1.5\nalpha = nan",
+            &["s.toml: material `white`: alpha = NaN must be in [1e-4, 1]"],
+        ),
+        material(
+            "lambertian albedo above 1",
+            "type = \"lambertian\"\nalbedo = [1.2, 0.5, 0.5]",
+            &["s.toml: material `white`: albedo = [1.2, 0.5, 0.5] must lie in [0, 1]"],
+        ),
+        material(
+            "glossy specular negative",
+            "type = \"glossy\"\nalbedo = [0.5, 0.5, 0.5]\nspecular = [-0.1, 0.2, 0.2]\nalpha = 0.1",
+            &["s.toml: material `white`: specular = [-0.1, 0.2, 0.2] must lie in [0, 1]"],
+        ),
+        material(
+            "glossy albedo + specular above 1",
+            "type = \"glossy\"\nalbedo = [0.5, 0.5, 0.5]\nspecular = [0.6, 0.2, 0.2]\nalpha = 0.1",
+            &["s.toml: material `white`: albedo + specular = [1.1, 0.7, 0.7] exceeds 1"],
+        ),
+        material(
+            "mirror reflectance above 1",
+            "type = \"mirror\"\nreflectance = [1.5, 1, 1]",
+            &["s.toml: material `white`: reflectance = [1.5, 1, 1] must lie in [0, 1]"],
+        ),
+        material(
+            "dielectric ior = 0",
+            "type = \"dielectric\"\nior = 0",
+            &["s.toml: material `white`: ior = 0 must be in (0, 10)"],
+        ),
+        material(
+            "rough_dielectric ior = 12",
+            "type = \"rough_dielectric\"\nior = 12\nalpha = 0.1",
+            &["s.toml: material `white`: ior = 12 must be in (0, 10)"],
+        ),
+        material(
+            "rough_conductor eta = 0",
+            "type = \"rough_conductor\"\nalpha = 0.1\neta = [0, 1, 1]\nk = [1, 1, 1]",
+            &["s.toml: material `white`: eta = [0, 1, 1] must be finite and > 0"],
+        ),
+        material(
+            "rough_conductor k negative",
+            "type = \"rough_conductor\"\nalpha = 0.1\neta = [1, 1, 1]\nk = [-1, 1, 1]",
+            &["s.toml: material `white`: k = [-1, 1, 1] must be finite and >= 0"],
+        ),
+        material(
+            "rough_conductor eta without k",
+            "type = \"rough_conductor\"\nalpha = 0.1\neta = [1, 1, 1]",
+            &["s.toml: material `white`: eta and k", "k is missing"],
+        ),
+        // A texture brighter than 1 under a diffuse albedo.
+        Case {
+            name: "lambertian albedo x texture above 1",
+            files: with(
+                files(
+                    scene(
+                        "[material.white]\ntype = \"lambertian\"\nalbedo = [0.7, 0.7, 0.7]\ntexture = \"t.exr\"\n",
+                    ),
+                    OBJ,
+                    MTL,
+                ),
+                "t.exr",
+                Input::Exr(film::Image::from_fn(2, 2, |_, _| [4.0; 3])),
+            ),
+            setup: vec![],
+            prepare: None,
+            args: "info {d}/s.toml",
+            code: 0,
+            words: &[],
+            check: texture_scaled(&["s.toml: material `white`", "brightest texel", "exceeds 1"]),
         },
     ]
 }

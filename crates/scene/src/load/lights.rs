@@ -2,7 +2,7 @@
 //! and the scene file's `[[light]]` tables, each checked and turned into a [`Light`], then
 //! the [`LightTable`] over all of them.
 
-use super::Builder;
+use super::{Builder, MAX_COORD};
 use crate::envmap::EnvMap;
 use crate::error::SceneError;
 use crate::file::{EmissionSource, LightDesc, SceneFile};
@@ -12,6 +12,11 @@ use crate::lights::{
 use crate::texture::Texture;
 use glam::{DVec3, Vec3};
 use math::Frame;
+
+/// True for a finite point farther out than any vertex may lie.
+fn beyond(p: Vec3) -> bool {
+    p.is_finite() && p.abs().max_element() as f64 > MAX_COORD
+}
 
 /// Delta lights' power does not depend on the scene's bounding sphere.
 const NO_SPHERE: Sphere = Sphere {
@@ -134,6 +139,15 @@ impl Builder<'_> {
             if !position.is_finite() {
                 return Err(bad("position must be finite"));
             }
+            // Past the bound vertices have, a light's irradiance underflows f32: the scene
+            // renders black without a word.
+            if beyond(position) {
+                return Err(bad(&format!(
+                    "position {:?} lies beyond the {MAX_COORD:e} scene units photonflow can \
+                     trace",
+                    position.to_array()
+                )));
+            }
             if !intensity.is_finite() || intensity.min_element() < 0.0 {
                 return Err(bad("intensity must be finite and >= 0"));
             }
@@ -155,6 +169,12 @@ impl Builder<'_> {
                     beam_width,
                     ..
                 } => {
+                    if beyond(Vec3::from(look_at)) {
+                        return Err(bad(&format!(
+                            "look_at {look_at:?} lies beyond the {MAX_COORD:e} scene units \
+                             photonflow can trace"
+                        )));
+                    }
                     let axis = (Vec3::from(look_at) - position).normalize_or_zero();
                     if !Vec3::from(look_at).is_finite() || axis == Vec3::ZERO {
                         return Err(bad("look_at must be finite and differ from position"));

@@ -12,6 +12,11 @@ use crate::texture::Texture;
 use glam::Vec3;
 use std::path::Path;
 
+/// How an MTL file names a material's albedo, its texture and its specular reflectance.
+pub(super) const MTL_KEYS: [&str; 3] = ["`Kd`", "`map_Kd`", "`Ks`"];
+/// How the scene file names them.
+const FILE_KEYS: [&str; 3] = ["albedo", "texture", "specular"];
+
 /// A scene-file material and its emission.
 pub(super) fn of_desc(desc: &MaterialDesc) -> (Material, Vec3) {
     match desc {
@@ -124,35 +129,59 @@ impl Builder<'_> {
 
     /// Gives material `id` the albedo texture at `path`, the material's own albedo becoming
     /// the texture's scale. Only materials with a diffuse lobe take one; for the others the
-    /// texture is not drawn. `Ok` holds a warning, if any; `Err` the problem with the image.
+    /// texture is not drawn. Where the albedo times the brightest texel (plus the specular
+    /// reflectance) exceeds 1 in a channel, the material is scaled there to 1: no point
+    /// reflects more than it gets. `keys` names the albedo, the texture and the specular
+    /// reflectance in messages ([`MTL_KEYS`], [`FILE_KEYS`]). `Ok` holds a warning, if any;
+    /// `Err` the problem with the image.
     pub(super) fn attach_albedo_map(
         &mut self,
         id: u32,
         path: &Path,
+        keys: [&str; 3],
     ) -> Result<Option<String>, String> {
+        let [kd, map, ks] = keys;
         let Some(m) = self.materials.get(id as usize).cloned() else {
             return Err(format!("internal error: material id {id}"));
         };
         let texture = self.texture(path)?;
+        let t_max = self
+            .textures
+            .get(texture as usize)
+            .map_or(Vec3::ONE, Texture::max);
+        // The factor per channel that brings `peak` down to 1 where it exceeds it.
+        let to_one = |peak: Vec3| Vec3::select(peak.cmpgt(Vec3::ONE), peak.recip(), Vec3::ONE);
         let mut warning = None;
         let scale = match m {
-            Material::Lambertian { albedo } => albedo,
+            Material::Lambertian { albedo } => {
+                // An HDR texture may hold texels far above 1 (an EXR of 4 under `Kd 0.7`
+                // reflected 2.8 times the light it got).
+                let peak = albedo * t_max;
+                let f = to_one(peak);
+                if f != Vec3::ONE {
+                    warning = Some(format!(
+                        "{kd} x {map}'s brightest texel exceeds 1 in a channel ({} {} {}): {kd} \
+                         scaled there so that texel reflects 1",
+                        peak.x, peak.y, peak.z
+                    ));
+                    if let Some(mat) = self.materials.get_mut(id as usize) {
+                        *mat = Material::Lambertian { albedo: albedo * f };
+                    }
+                }
+                albedo * f
+            }
             Material::Glossy {
                 albedo,
                 specular,
                 alpha,
             } => {
                 // The untextured rule (`Kd + Ks <= 1` per channel, both scaled there where
-                // not) over the texture's brightest texel: no point reflects more than it gets.
-                let t_max = self
-                    .textures
-                    .get(texture as usize)
-                    .map_or(Vec3::ONE, Texture::max);
+                // not) over the texture's brightest texel.
                 let sum = albedo * t_max + specular;
-                let f = Vec3::select(sum.cmpgt(Vec3::ONE), sum.recip(), Vec3::ONE);
+                let f = to_one(sum);
                 if f != Vec3::ONE {
                     warning = Some(format!(
-                        "`Kd` x `map_Kd`'s brightest texel + `Ks` exceeds 1 in a channel ({} {} \
+                        "{kd} x {map}'s brightest texel + {ks} exceeds 1 in a channel ({} {} \
                          {}): both scaled there to sum to 1",
                         sum.x, sum.y, sum.z
                     ));
@@ -168,7 +197,7 @@ impl Builder<'_> {
             }
             _ => {
                 return Ok(Some(format!(
-                    "`map_Kd {}`: only diffuse and glossy (illum 0-2) materials are textured; \
+                    "{map} ({}): only diffuse and glossy (illum 0-2) materials are textured; \
                      this one is drawn without it",
                     path.display()
                 )));
@@ -180,96 +209,34 @@ impl Builder<'_> {
         Ok(warning)
     }
 
+    /// Every material's values against their ranges ([`check`], with the scene file's key
+    /// names), and its emission.
     pub(super) fn validate_materials(&self) -> Result<(), SceneError> {
-        let glass_ok = |ior: f32, transmittance: Vec3, absorption: Vec3| {
-            ior.is_finite()
-                && ior > 0.0
-                && ior < 10.0
-                && in_unit(transmittance)
-                && non_negative(absorption)
-        };
         for (name, m) in self.names.iter().zip(&self.materials) {
-            // Glass's own keys first, each named alone.
-            if let Material::Dielectric {
-                transmittance,
-                absorption,
-                ..
-            }
-            | Material::RoughDielectric {
-                transmittance,
-                absorption,
-                ..
-            } = m
-            {
-                if !in_unit(*transmittance) {
-                    return Err(self.err(format!(
-                        "material `{name}`: transmittance {:?} must lie in [0, 1] in each channel",
-                        transmittance.to_array()
-                    )));
-                }
-                if !non_negative(*absorption) {
-                    return Err(self.err(format!(
-                        "material `{name}`: absorption {:?} must be finite and >= 0 in each \
-                         channel (per scene unit)",
-                        absorption.to_array()
-                    )));
-                }
-            }
-            let ok = match m {
-                Material::Lambertian { albedo } => in_unit(*albedo),
-                Material::Mirror { reflectance } | Material::Metal { reflectance } => {
-                    in_unit(*reflectance)
-                }
-                Material::Dielectric {
-                    ior,
-                    transmittance,
-                    absorption,
-                } => glass_ok(*ior, *transmittance, *absorption),
-                Material::Glossy {
-                    albedo,
-                    specular,
-                    alpha,
-                } => {
-                    in_unit(*albedo)
-                        && in_unit(*specular)
-                        // MTL's scaling to a sum of 1 may round a hair above it.
-                        && in_unit((*albedo + *specular) / (1.0 + 1e-6))
-                        && ALPHA_RANGE.contains(alpha)
-                }
-                Material::RoughConductor {
-                    reflectance,
-                    alpha,
-                    eta,
-                } => {
-                    in_unit(*reflectance)
-                        && ALPHA_RANGE.contains(alpha)
-                        && eta.is_none_or(|(e, k)| {
-                            e.is_finite()
-                                && k.is_finite()
-                                && e.min_element() > 0.0
-                                && k.min_element() >= 0.0
-                        })
-                }
-                Material::RoughDielectric {
-                    ior,
-                    alpha,
-                    transmittance,
-                    absorption,
-                } => glass_ok(*ior, *transmittance, *absorption) && ALPHA_RANGE.contains(alpha),
-            };
-            if !ok {
-                return Err(self.err(format!(
-                    "material `{name}`: albedo/reflectance/transmittance (and albedo + \
-                     specular) must lie in [0, 1], ior in (0, 10), alpha in [1e-4, 1], \
-                     absorption be finite and >= 0, eta > 0 and k >= 0 given together (got \
-                     {m:?})"
-                )));
-            }
+            check(m, str::to_string).map_err(|p| self.err(format!("material `{name}`: {p}")))?;
         }
         for (name, e) in self.names.iter().zip(&self.emission) {
             if !(e.is_finite() && e.min_element() >= 0.0) {
                 return Err(self.err(format!(
-                    "material `{name}`: emission must be finite and >= 0"
+                    "material `{name}`: emission = {} must be finite and >= 0 in each channel",
+                    list(*e)
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// What the scene file's descriptions say that their [`Material`]s cannot: a rough
+    /// conductor's `eta` or `k` given alone.
+    pub(super) fn check_descs(&self, file: &SceneFile) -> Result<(), SceneError> {
+        for (name, desc) in &file.materials {
+            if let MaterialDesc::RoughConductor { eta, k, .. } = desc
+                && eta.is_some() != k.is_some()
+            {
+                let missing = if eta.is_some() { "k" } else { "eta" };
+                return Err(self.err(format!(
+                    "material `{name}`: eta and k are given together or not at all \
+                     ({missing} is missing)"
                 )));
             }
         }
@@ -290,7 +257,7 @@ impl Builder<'_> {
             };
             let image = self.dir.join(t);
             let id = self.by_name.get(name).copied().unwrap_or(u32::MAX);
-            let warned = self.attach_albedo_map(id, &image).map_err(|p| {
+            let warned = self.attach_albedo_map(id, &image, FILE_KEYS).map_err(|p| {
                 self.err(format!(
                     "material `{name}`: texture `{t}` ({}): {p}",
                     image.display()
@@ -309,4 +276,122 @@ pub(super) fn in_unit(v: Vec3) -> bool {
 
 pub(super) fn non_negative(v: Vec3) -> bool {
     v.is_finite() && v.min_element() >= 0.0
+}
+
+/// `[x, y, z]`, as the scene file writes a colour.
+fn list(v: Vec3) -> String {
+    format!("[{}, {}, {}]", v.x, v.y, v.z)
+}
+
+/// Material `m`'s values, each against its range. `Err` names the first key out of it, as
+/// `key` spells the scene file's key (an MTL file has its own), and its value.
+pub(super) fn check(m: &Material, key: impl Fn(&str) -> String) -> Result<(), String> {
+    let unit = |k: &str, v: Vec3| {
+        if in_unit(v) {
+            Ok(())
+        } else {
+            Err(format!(
+                "{} = {} must lie in [0, 1] in each channel",
+                key(k),
+                list(v)
+            ))
+        }
+    };
+    let alpha = |a: f32| {
+        if ALPHA_RANGE.contains(&a) {
+            Ok(())
+        } else {
+            Err(format!("{} = {a} must be in [1e-4, 1]", key("alpha")))
+        }
+    };
+    let ior = |i: f32| {
+        if i.is_finite() && i > 0.0 && i < 10.0 {
+            Ok(())
+        } else {
+            Err(format!("{} = {i} must be in (0, 10)", key("ior")))
+        }
+    };
+    let glass = |t: Vec3, a: Vec3| {
+        unit("transmittance", t)?;
+        if non_negative(a) {
+            Ok(())
+        } else {
+            Err(format!(
+                "{} = {} must be finite and >= 0 in each channel (per scene unit)",
+                key("absorption"),
+                list(a)
+            ))
+        }
+    };
+    match *m {
+        Material::Lambertian { albedo } => unit("albedo", albedo),
+        Material::Mirror { reflectance } | Material::Metal { reflectance } => {
+            unit("reflectance", reflectance)
+        }
+        Material::Dielectric {
+            ior: i,
+            transmittance,
+            absorption,
+        } => {
+            glass(transmittance, absorption)?;
+            ior(i)
+        }
+        Material::Glossy {
+            albedo,
+            specular,
+            alpha: a,
+        } => {
+            unit("albedo", albedo)?;
+            unit("specular", specular)?;
+            let sum = albedo + specular;
+            // MTL's scaling to a sum of 1 may round a hair above it.
+            if !in_unit(sum / (1.0 + 1e-6)) {
+                return Err(format!(
+                    "{} + {} = {} exceeds 1 in a channel: no surface reflects more than it \
+                     receives",
+                    key("albedo"),
+                    key("specular"),
+                    list(sum)
+                ));
+            }
+            alpha(a)
+        }
+        Material::RoughConductor {
+            reflectance,
+            alpha: a,
+            eta,
+        } => {
+            unit("reflectance", reflectance)?;
+            alpha(a)?;
+            let Some((e, k)) = eta else {
+                return Ok(());
+            };
+            if !(e.is_finite() && e.min_element() > 0.0) {
+                return Err(format!(
+                    "{} = {} must be finite and > 0 in each channel",
+                    key("eta"),
+                    list(e)
+                ));
+            }
+            if non_negative(k) {
+                Ok(())
+            } else {
+                Err(format!(
+                    "{} = {} must be finite and >= 0 in each channel",
+                    key("k"),
+                    list(k)
+                ))
+            }
+        }
+        Material::RoughDielectric {
+            ior: i,
+            alpha: a,
+            transmittance,
+            absorption,
+        } => {
+            glass(transmittance, absorption)?;
+            ior(i)?;
+            alpha(a)
+        }
+    }
 }

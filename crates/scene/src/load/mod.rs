@@ -174,6 +174,7 @@ impl<'a> Builder<'a> {
     /// The scene: materials and their textures, meshes, spheres, camera, lights, in that
     /// order (each step's errors assume the ones before passed).
     fn build(mut self, file: SceneFile) -> Result<Scene, SceneError> {
+        self.check_descs(&file)?;
         self.validate_materials()?;
         self.scene_file_textures(&file)?;
         for (i, m) in file.meshes.iter().enumerate() {

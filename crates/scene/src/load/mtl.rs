@@ -11,53 +11,99 @@
 //! | `illum 0`, `1`, no `illum` | Lambertian `Kd` (a `Ks` there is not drawn: warning) |
 //! | `illum 2` | Lambertian `Kd`, plus with `Ks > 0` a GGX lobe of constant reflectance `Ks` (no Fresnel) of roughness α = √(2 / (`Ns` + 2)) (Walter et al. 2007); where `Kd + Ks` exceeds 1 in a channel both are scaled there to sum to 1 (warning) |
 //! | `illum 3`, `5`, `8` | mirror of reflectance `Ks` (1 where `Ks` is absent or black); illum 5's Fresnel term and illum 8's "ray trace off" are not modelled, nor a `Kd` beside the mirror (warnings) |
-//! | `illum 4`, `6`, `7`, `9` | glass of index `Ni` and transmittance `Tf`, exact Fresnel reflection and refraction (index 1.5 where `Ni` is absent or <= 1, and illum 6's and 9's variants: warnings) |
+//! | `illum 4`, `6`, `7`, `9` | glass of index `Ni` and transmittance `Tf`, exact Fresnel reflection and refraction (index 1.5 where `Ni` is absent or in [0, 1], and illum 6's and 9's variants: warnings; a negative or NaN `Ni` is refused) |
 //! | `illum 10` | refused (shadow matte) |
 //! | `illum 11` | the course's metal: constant reflectance `Ks` |
-//! | `d < 1`, `Tr > 0` | glass (illum 4, 6, 7, 9, or the course's illum 0-2 with `Ni > 1`); refused on any other surface |
+//! | `d < 1`, `Tr > 0` | glass (illum 4, 6, 7, 9, or the course's illum 0-2 with `Ni > 1`); refused on any other surface. `d` and `Tr` both given and disagreeing (`Tr` is 1 - `d`): `d` is used (warning) |
+//! | `newmtl` of a name defined before | the last definition is used, as other loaders do (warning) |
 //! | `Ke` | emitted radiance (`emission = "ke"`, the default) |
 //! | `Ka` | emitted radiance with `[[mesh]] emission = "ka"` (the course's convention; a material with `Ke` too is refused); otherwise the ambient colour, which a physically based renderer does not use |
 //! | `Ni` | the index of refraction of glass; not read elsewhere |
+//! | `Ks` | the specular colour of illum 2, 3, 5, 8 and 11 (above; elsewhere: warning); negative or NaN in a channel, refused whatever the `illum` |
 //! | `Tf` | on glass, its transmittance: a factor on refracted light at every crossing, each channel in [0, 1] (refused outside it); warning elsewhere. Absorption inside glass has no MTL key: use the scene file's `absorption` |
-//! | `map_Kd` | the diffuse albedo's texture, times `Kd` (the MTL spec's product; the texture alone where `Kd` is absent): PNG, JPEG, TGA or EXR, relative to the MTL file; 8-bit and 16-bit images are sRGB-decoded, EXR is linear; read at the OBJ's `vt` (without them, at each triangle's barycentrics: warning), bilinear, repeated. On illum 0-2 only (elsewhere: warning, drawn without). A missing or unreadable image, or texture options (`-s`, `-o`, ...), are refused |
+//! | `map_Kd` | the diffuse albedo's texture, times `Kd` (the MTL spec's product; the texture alone where `Kd` is absent): PNG, JPEG, TGA or EXR, relative to the MTL file; 8-bit and 16-bit images are sRGB-decoded, EXR is linear; read at the OBJ's `vt` (without them, at each triangle's barycentrics: warning), bilinear, repeated. On illum 0-2 only (elsewhere: warning, drawn without). Where `Kd` x the brightest texel (+ `Ks` on illum 2) exceeds 1 in a channel, they are scaled there to 1 (warning). A missing or unreadable image, or texture options (`-s`, `-o`, ...), are refused |
 //! | `map_Ks`, `map_d` | refused (of the texture maps only `map_Kd` is rendered) |
 //! | `bump`, `map_Bump`, `map_Ns`, `refl`, `disp`, `decal` | warning: drawn without |
 //! | `Pr`, `Pm`, `Ps`, `Pc`, `Pcr`, `aniso`, `anisor`, `map_Pr`, `map_Pm` (the PBR extension) | refused |
 
-use super::materials::in_unit;
+use super::materials::{check, in_unit};
 use crate::file::EmissionSource;
 use crate::material::ALPHA_RANGE;
 use crate::material::Material;
 use glam::Vec3;
 
-/// MTL colours (`Ka`, `Kd`, `Ks`, `Ke`, `Tf`) given with one number are grey, a variant real
-/// MTL files use: written out as three numbers here, since tobj panics on fewer than three.
-/// Two numbers or none is an error naming the line.
-pub(super) fn grey_colours(bytes: &[u8]) -> Result<Vec<u8>, String> {
+/// The MTL text checked line by line before tobj reads it: a value tobj cannot parse (it
+/// says only "material parse error") is refused here naming its line and text. Colours
+/// (`Ka`, `Kd`, `Ks`, `Ke`, `Tf`) given with one number are grey, a variant real MTL files
+/// use: written out as three numbers here, since tobj panics on fewer than three. Two
+/// numbers or none is an error naming the line.
+pub(super) fn prescan(bytes: &[u8]) -> Result<Vec<u8>, String> {
     let Ok(text) = std::str::from_utf8(bytes) else {
         return Err("not UTF-8 text".into());
     };
     let mut out = String::with_capacity(text.len() + 64);
     for (i, line) in text.split_inclusive('\n').enumerate() {
+        let n = i + 1;
         let mut words = line.split_whitespace();
-        let key = words.next();
-        if let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke" | "Tf")) = key {
-            let args: Vec<&str> = words.collect();
-            let numbers = args.iter().take_while(|w| w.parse::<f32>().is_ok()).count();
-            match (args.as_slice(), numbers) {
-                ([v], 1) => {
-                    out.push_str(&format!("{key} {v} {v} {v}\n"));
-                    continue;
+        let Some(key) = words.next() else {
+            out.push_str(line);
+            continue;
+        };
+        let args: Vec<&str> = words.collect();
+        let is_number = |w: &&str| w.parse::<f32>().is_ok();
+        let not_a_number = |w: &str, hint: &str| {
+            Err(format!(
+                "line {n}: `{}`: `{w}` is not a number{hint}",
+                line.trim()
+            ))
+        };
+        match key {
+            "Ka" | "Kd" | "Ks" | "Ke" | "Tf" => {
+                if let Some(w) = args.iter().take(3).find(|w| !is_number(w)) {
+                    let hint = if matches!(args.first(), Some(&("spectral" | "xyz"))) {
+                        " (the spectral and xyz forms are not read: give RGB)"
+                    } else {
+                        ""
+                    };
+                    return not_a_number(w, hint);
                 }
-                ([], _) | ([_, _], 2) => {
-                    return Err(format!(
-                        "line {}: `{key}` needs one number (grey) or three (RGB), got {}",
-                        i + 1,
-                        args.len()
-                    ));
+                match args.as_slice() {
+                    [v] => {
+                        out.push_str(&format!("{key} {v} {v} {v}\n"));
+                        continue;
+                    }
+                    [] | [_, _] => {
+                        return Err(format!(
+                            "line {n}: `{key}` needs one number (grey) or three (RGB), got {}",
+                            args.len()
+                        ));
+                    }
+                    _ => {}
                 }
-                _ => {}
             }
+            // tobj reads the first word of these as a number and ignores the rest.
+            "Ns" | "Ni" | "d" | "Tr" => match args.first() {
+                None => return Err(format!("line {n}: `{key}` needs a number")),
+                Some(w) if !is_number(w) => return not_a_number(w, ""),
+                Some(_) => {}
+            },
+            "illum" if args.first().is_none_or(|w| w.parse::<u8>().is_err()) => {
+                return Err(format!(
+                    "line {n}: `{}`: the illumination model must be a whole number (the MTL \
+                     spec's 0-10, the course's 11)",
+                    line.trim()
+                ));
+            }
+            "newmtl" if args.is_empty() => {
+                return Err(format!("line {n}: `newmtl` needs a material name"));
+            }
+            "map_Ka" | "map_Kd" | "map_Ks" | "map_Bump" | "map_bump" | "map_Ns" | "map_ns"
+            | "map_NS" | "bump" | "map_d"
+                if args.is_empty() =>
+            {
+                return Err(format!("line {n}: `{key}` needs an image file name"));
+            }
+            _ => {}
         }
         out.push_str(line);
     }
@@ -152,6 +198,13 @@ fn read_keys(m: &tobj::Material, emission: EmissionSource) -> Result<Keys, Strin
         None => None,
     };
     let opacity = m.dissolve.or(tr.map(|t| 1.0 - t)).unwrap_or(1.0);
+    if let (Some(d), Some(t)) = (m.dissolve, tr)
+        && (d - (1.0 - t)).abs() > 1e-3
+    {
+        warnings.push(format!(
+            "`d {d}` and `Tr {t}` disagree (`Tr` is 1 - `d`): `d` is used, opacity {d}"
+        ));
+    }
     if !(0.0..=1.0).contains(&opacity) {
         return Err(format!("`d`/`Tr`: opacity {opacity} must lie in [0, 1]"));
     }
@@ -243,6 +296,14 @@ pub(super) fn convert_mtl(
              glass (illum 4, 6, 7 or 9 with `Ni`)"
         ));
     }
+    // Checked before the model is chosen: a negative or NaN `Ks` would otherwise fail
+    // `Ks > 0` and draw a Lambertian surface without a word.
+    if let Some(k) = ks_given.filter(|k| !(k.is_finite() && k.min_element() >= 0.0)) {
+        return Err(format!(
+            "`Ks {} {} {}`: the specular reflectance must be a number >= 0 in each channel",
+            k.x, k.y, k.z
+        ));
+    }
     let glassy = glass_illum || course_glass;
     if glassy && tf.is_some_and(|t| !in_unit(t)) {
         return Err(format!(
@@ -257,7 +318,7 @@ pub(super) fn convert_mtl(
         ));
     }
     let mat = match illum {
-        _ if course_glass => glass(&mut warnings, "", m, tf),
+        _ if course_glass => glass(&mut warnings, "", m, tf)?,
         Some(2) if ks.max_element() > 0.0 => {
             let ns = m.shininess.unwrap_or(0.0);
             if !(ns.is_finite() && ns >= 0.0) {
@@ -307,20 +368,20 @@ pub(super) fn convert_mtl(
             m,
             kd,
         ),
-        Some(4 | 7) => glass(&mut warnings, "", m, tf),
+        Some(4 | 7) => glass(&mut warnings, "", m, tf)?,
         Some(6) => glass(
             &mut warnings,
             "illum 6 (refraction, Fresnel off): drawn as glass with Fresnel reflection",
             m,
             tf,
-        ),
+        )?,
         Some(9) => glass(
             &mut warnings,
             "illum 9 (glass without ray-traced reflection): drawn as glass with Fresnel \
              reflection",
             m,
             tf,
-        ),
+        )?,
         Some(10) => {
             return Err(
                 "illum 10 (a shadow matte: shadows cast onto invisible surfaces) \
@@ -337,6 +398,17 @@ pub(super) fn convert_mtl(
             ));
         }
     };
+    check(&mat, |k| {
+        match k {
+            "albedo" => "`Kd`",
+            "specular" | "reflectance" => "`Ks`",
+            "ior" => "`Ni`",
+            "transmittance" => "`Tf`",
+            "alpha" => "alpha (from `Ns`)",
+            other => other,
+        }
+        .to_string()
+    })?;
     Ok(Converted {
         material: mat,
         emission: e,
@@ -370,9 +442,15 @@ fn mirror(warnings: &mut Vec<String>, why: &str, m: &tobj::Material, kd: Vec3) -
     Material::Mirror { reflectance }
 }
 
-/// Glass of index `Ni` (1.5 where absent or not above 1: warning) and transmittance `tf`,
-/// with `why` (if not empty) and an unused `Ks` warned about.
-fn glass(warnings: &mut Vec<String>, why: &str, m: &tobj::Material, tf: Option<Vec3>) -> Material {
+/// Glass of index `Ni` (1.5 where absent or in [0, 1]: warning; refused where negative or
+/// not a number) and transmittance `tf`, with `why` (if not empty) and an unused `Ks` warned
+/// about.
+fn glass(
+    warnings: &mut Vec<String>,
+    why: &str,
+    m: &tobj::Material,
+    tf: Option<Vec3>,
+) -> Result<Material, String> {
     let ni = m.optical_density;
     let ks_given = m.specular.map(Vec3::from);
     let ks = ks_given.unwrap_or(Vec3::ZERO);
@@ -381,6 +459,13 @@ fn glass(warnings: &mut Vec<String>, why: &str, m: &tobj::Material, tf: Option<V
     }
     let ior = match ni {
         Some(n) if n > 1.0 => n,
+        // Exporters write `Ni 0` for "unset"; a negative or NaN index is no such convention.
+        Some(n) if n.is_nan() || n < 0.0 => {
+            return Err(format!(
+                "`Ni {n}`: the index of refraction of glass must be a number above 1 (0, which \
+                 exporters write for unset, is drawn as 1.5)"
+            ));
+        }
         _ => {
             warnings.push(format!(
                 "glass without an index above 1 (`Ni {}`): drawn with index 1.5",
@@ -397,9 +482,9 @@ fn glass(warnings: &mut Vec<String>, why: &str, m: &tobj::Material, tf: Option<V
     }
     // `Tf` scales refracted light at every crossing: Mitsuba 3's
     // `specular_transmittance`, which the peers' mapping gives it too.
-    Material::Dielectric {
+    Ok(Material::Dielectric {
         ior,
         transmittance: tf.unwrap_or(Vec3::ONE),
         absorption: Vec3::ZERO,
-    }
+    })
 }

@@ -3,7 +3,8 @@
 //! texture coordinates kept, every problem named with its file and line.
 
 use super::Builder;
-use super::mtl::{convert_mtl, grey_colours};
+use super::materials::MTL_KEYS;
+use super::mtl::{convert_mtl, prescan};
 use super::transform::transform;
 use super::{MAX_COORD, read_regular};
 use crate::error::SceneError;
@@ -11,6 +12,7 @@ use crate::file::{EmissionSource, MeshDesc, NormalMode};
 use geom::{TriMesh, smooth_vertex_normals};
 use glam::{DMat3, DMat4, DVec3, Vec2};
 use std::cell::RefCell;
+use std::collections::HashMap;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
@@ -51,7 +53,7 @@ impl Builder<'_> {
         Ok(())
     }
 
-    /// Reads the OBJ file and the MTL files it names (each through [`grey_colours`]).
+    /// Reads the OBJ file and the MTL files it names (each through [`prescan`]).
     fn parse_obj(
         &mut self,
         index: usize,
@@ -94,7 +96,7 @@ impl Builder<'_> {
                     Ok(b) => {
                         mtl_bytes.borrow_mut().extend_from_slice(&b);
                         mtl_files.borrow_mut().push(p.display().to_string());
-                        let b = match grey_colours(&b) {
+                        let b = match prescan(&b) {
                             Ok(b) => b,
                             Err(problem) => {
                                 *mtl_error.borrow_mut() = Some(SceneError::new(
@@ -153,9 +155,21 @@ impl Builder<'_> {
         obj_path: &Path,
         emission: EmissionSource,
     ) -> Result<Vec<u32>, SceneError> {
-        let mut mat_ids = Vec::with_capacity(parsed.materials.len());
+        let mats = &parsed.materials;
+        // tobj's `usemtl` reads the last of several definitions of one name, as other loaders
+        // do: an earlier one is skipped (with a warning) and shares the last one's id.
+        let mut last: HashMap<&str, (usize, usize)> = HashMap::new();
+        for (i, m) in mats.iter().enumerate() {
+            let e = last.entry(m.name.as_str()).or_insert((i, 0));
+            *e = (i, e.1 + 1);
+        }
+        let mut ids: Vec<Option<u32>> = Vec::with_capacity(mats.len());
         let defined_in = &parsed.defined_in;
-        for m in &parsed.materials {
+        for (i, m) in mats.iter().enumerate() {
+            let Some(&(_, times)) = last.get(m.name.as_str()).filter(|l| l.0 == i) else {
+                ids.push(None);
+                continue;
+            };
             let id = match self.by_name.get(&m.name) {
                 Some(&id) => id,
                 None => {
@@ -165,6 +179,12 @@ impl Builder<'_> {
                         .find(|(_, names)| names.contains(&m.name))
                         .map_or(obj_path.to_path_buf(), |(p, _)| p.clone());
                     let at = |p: String| format!("{}: material `{}`: {p}", mtl.display(), m.name);
+                    if times > 1 {
+                        self.warnings.push(at(format!(
+                            "defined {times} times; the last definition is used, as other \
+                             loaders do"
+                        )));
+                    }
                     let c = convert_mtl(m, emission).map_err(|p| {
                         SceneError::new(&mtl, format!("material `{}`: {p}", m.name))
                     })?;
@@ -172,7 +192,7 @@ impl Builder<'_> {
                     let id = self.add_material(&m.name, c.material, c.emission);
                     if let Some(t) = &c.albedo_map {
                         let image = mtl.parent().unwrap_or(Path::new("")).join(t);
-                        let warned = self.attach_albedo_map(id, &image).map_err(|p| {
+                        let warned = self.attach_albedo_map(id, &image, MTL_KEYS).map_err(|p| {
                             SceneError::new(
                                 &mtl,
                                 format!(
@@ -187,9 +207,23 @@ impl Builder<'_> {
                     id
                 }
             };
-            mat_ids.push(id);
+            ids.push(Some(id));
         }
-        Ok(mat_ids)
+        let of_last = |m: &tobj::Material| {
+            let l = last.get(m.name.as_str())?.0;
+            ids.get(l).copied().flatten()
+        };
+        ids.iter()
+            .zip(mats)
+            .map(|(id, m)| {
+                id.or_else(|| of_last(m)).ok_or_else(|| {
+                    SceneError::new(
+                        obj_path,
+                        format!("internal error: material `{}` has no id", m.name),
+                    )
+                })
+            })
+            .collect()
     }
 
     /// One model (an `o`/`g` group) of the OBJ, its faces triangulated and transformed,

@@ -189,6 +189,15 @@ fn mtl_files_follow_the_documented_table() {
         "glass reflects by the Fresnel",
     );
     assert_eq!(quiet("Ni 1.5\nTr 0.9\nillum 7"), Material::glass(1.5));
+    // `d` and `Tr` both: `d` is used, with a warning where they disagree.
+    assert_eq!(
+        quiet("Ni 1.5\nd 0.1\nTr 0.9\nillum 7"),
+        Material::glass(1.5)
+    );
+    assert_eq!(
+        warned("Kd 0.5 0.5 0.5\nd 1\nTr 0.5", "`d` is used"),
+        Material::Lambertian { albedo: v(0.5) }
+    );
     // Course metal.
     assert_eq!(
         quiet("Ks 0.96 0.98 0.96\nillum 11"),
@@ -235,6 +244,17 @@ fn mtl_files_follow_the_documented_table() {
         "must lie in [0, 1]",
     );
     refused("Ni 1.5\nTf nan 0.5 0.5\nillum 4", "ke", "`Tf nan 0.5 0.5`");
+    // A negative or NaN `Ni` on glass is no exporter's "unset" (`Ni 0` is: warned above).
+    refused("Ni nan\nillum 7", "ke", "`Ni NaN`");
+    refused("Ni -1.5\nillum 4", "ke", "`Ni -1.5`");
+    warned("Ni 0\nillum 7", "`Ni 0`): drawn with index 1.5");
+    // `Ks` is checked before the model is chosen, whatever the `illum`.
+    refused(
+        "Kd 0.5 0.5 0.5\nKs -0.5 -0.5 -0.5\nillum 2",
+        "ke",
+        "`Ks -0.5 -0.5 -0.5`",
+    );
+    refused("Kd 0.5 0.5 0.5\nKs nan 0 0\nillum 1", "ke", "`Ks NaN 0 0`");
     refused("Kd 0.5 0.5 0.5\nd 0.5", "ke", "opacity 0.5");
     refused("Kd 0.5 0.5 0.5\nTr 0.5", "ke", "opacity 0.5");
     refused("Kd 0.5 0.5 0.5\nPr 0.5", "ke", "`Pr 0.5`");
