@@ -442,7 +442,8 @@ fn sphere_under_a_constant_environment_image() {
 /// floor's edge (0.5%). Every strategy weighs these paths: light paths start on the disc of
 /// radius `R` (its density per area is the emission density), NEE towards the direction
 /// (delta for the directional light, the disc's cone for the sun), the camera and merging.
-/// Measured (16 x 16, 16 passes): TABLE_INF
+/// Measured (16 x 16, 16 passes): directional +0.33% (se 0.19%), sun +0.32% (se 0.19%), pixel
+/// sd 3%.
 #[test]
 fn directional_and_sun_over_a_plane_vcm() {
     for (name, angle) in [("directional", None), ("sun", Some(5.0))] {

@@ -54,8 +54,10 @@ fn furnace_closed_form(depth: u32) -> f64 {
 /// each of `k` eye vertices); a weight that does not sum to one over them moves the mean
 /// by its error at that length.
 ///
-/// Measured (six seeds, 16 passes each): TABLE_FURNACE from the closed form; bound: 4
-/// standard errors plus 0.1% (merging's bias where its disc crosses an edge of the box).
+/// Measured (six seeds, 16 passes each) from the closed form: 0 bounces exact (emission seen
+/// directly, weight 1), 1 bounce -0.018% ± 0.059%, 2 bounces +0.038% ± 0.060%, 4 bounces
+/// +0.036% ± 0.073%; bound: 4 standard errors plus 0.1% (merging's bias where its disc
+/// crosses an edge of the box).
 #[test]
 fn the_furnace_reads_its_closed_form_at_every_path_length() {
     for depth in [0, 1, 2, 4] {
@@ -76,8 +78,9 @@ fn the_furnace_reads_its_closed_form_at_every_path_length() {
 
 /// Every strategy carries a share of the furnace's paths: switched off (its weight still
 /// counted), the image loses that share, many standard errors below the closed form.
-/// Measured at 2 bounces, percent of the closed form lost: TABLE_SHARES; bound: 5 standard
-/// errors.
+/// Measured at 2 bounces, percent of the closed form lost (± its standard error): hits
+/// 81.99 ± 0.02, nee 12.29 ± 0.05, camera 0.64 ± 0.06, connect 3.47 ± 0.06, merge
+/// 1.45 ± 0.07; bound: 5 standard errors.
 #[test]
 fn each_strategy_carries_its_share() {
     let want = furnace_closed_form(2);

@@ -10,7 +10,7 @@ use scene::{Method, Scene};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// photonflow's methods in the table, in its column order.
+/// photonflow's methods in the table by default, in its column order.
 pub const METHODS: [Method; 5] = [
     Method::Sppm,
     Method::Vcm,
@@ -383,9 +383,24 @@ fn run_peer(
 
 /// `bench accuracy`: every case at every budget, photonflow's methods and the peers taking
 /// turns (each peer warmed up first), then each case's tables and what each peer ran.
-pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> Result<(), String> {
+pub fn accuracy(
+    cases: &[Case],
+    budgets: &[f64],
+    methods: &[Method],
+    peers: &[Peer],
+    dir: &Path,
+) -> Result<(), String> {
     if cases.is_empty() {
         return Err("no case: give --case SCENE.toml,REF_A.exr,REF_B.exr or --suite FILE".into());
+    }
+    if let Some(m) = methods
+        .iter()
+        .find(|m| render::methods::row(**m).passes.is_none())
+    {
+        return Err(format!(
+            "--methods {m}: it renders in one go and takes no time budget (progressive \
+             methods only)"
+        ));
     }
     if budgets.is_empty() || budgets.iter().any(|b| !(*b > 0.0 && b.is_finite())) {
         return Err(format!("--budgets {budgets:?}: positive seconds"));
@@ -436,7 +451,7 @@ pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> 
             name: name.into(),
             cells: Vec::new(),
         };
-        let mut ours: Vec<Column> = METHODS.iter().map(|m| column(&m.name())).collect();
+        let mut ours: Vec<Column> = methods.iter().map(|m| column(&m.name())).collect();
         let mut theirs: Vec<Column> = peers.iter().map(|p| column(&p.name)).collect();
         let mut notes: Vec<Option<String>> = vec![None; peers.len()];
         // A warm-up run of each peer at the smallest budget, untimed: its calibrations and
@@ -453,7 +468,7 @@ pub fn accuracy(cases: &[Case], budgets: &[f64], peers: &[Peer], dir: &Path) -> 
             out_of.push(r.err());
         }
         for &b in budgets {
-            for (m, col) in METHODS.iter().zip(&mut ours) {
+            for (m, col) in methods.iter().zip(&mut ours) {
                 let out = case_dir.join(format!("{}-{b}s", m.name().replace('+', "-")));
                 let r = run_ours(&scene, *m, b, &out, &cache, &scoring)?;
                 println!(

@@ -222,13 +222,19 @@ fn bench_accuracy(a: cli::BenchAccuracy) -> Result<(), String> {
         suite,
         refs,
         budgets,
+        methods,
         peer,
         dir,
     } = a;
     if let Some(suite) = suite {
         case.extend(lab::accuracy::read_suite(&suite, refs.as_deref())?);
     }
-    lab::accuracy::accuracy(&case, &budgets, &peer, &dir)
+    let methods = if methods.is_empty() {
+        lab::accuracy::METHODS.to_vec()
+    } else {
+        methods
+    };
+    lab::accuracy::accuracy(&case, &budgets, &methods, &peer, &dir)
 }
 
 fn evidence(a: cli::Evidence) -> Result<(), String> {

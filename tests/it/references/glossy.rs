@@ -90,10 +90,17 @@ fn a_glossy_receiver_matches_mitsuba() {
     assert!(!bad.is_empty(), "the floor's glossy lobe is not resolved");
 }
 
-/// Vertex connection and merging, 16 passes, over seeds 1-6: TABLE_GL
+/// Vertex connection and merging, 16 passes, over seeds 1-6 (`m / ref - 1` in percent):
+///
+/// | image | caustic | edges, corners | outer rim | glass | open walls | core |
+/// |---|---|---|---|---|---|---|
+/// | -0.10 ± 0.32 | -0.41 ± 0.42 | +0.51 ± 0.95 | -1.30 ± 0.90 | -0.58 ± 2.16 | +0.06 ± 0.19 | -0.19 ± 1.30 |
+///
+/// The outer rim's -1.3% is resolved (z -3.5), merging's disc running off the open front as
+/// on the worksheet; no other (|z| < 2.5).
 const GLOSSY_VCM_16: Measured = Measured {
-    bias: [0.0; 7],
-    sd: [0.01; 7],
+    bias: [0.0, 0.0, 0.0, -0.0130, 0.0, 0.0, 0.0],
+    sd: [0.0032, 0.0042, 0.0095, 0.0090, 0.0216, 0.0019, 0.0130],
 };
 
 /// The glossy floor by vertex connection and merging against Mitsuba: every region, the

@@ -85,10 +85,18 @@ fn light_tracing_matches_mitsubas_light_tracer_in_the_spot_box() {
     assert!(bad.is_empty(), "{bad:#?}");
 }
 
-/// Vertex connection and merging, 16 passes, over seeds 1-6 as above: TABLE_SB
+/// Vertex connection and merging, 16 passes, over seeds 1-6 as above:
+///
+/// | run | diffuse seen | lit | glass shadow | core | ceiling |
+/// |---|---|---|---|---|---|
+/// | vcm, 16 | +0.06 ± 0.25 | +0.10 ± 0.21 | +0.09 ± 1.19 | -1.43 ± 1.16 | -0.17 ± 0.43 |
+///
+/// The core's -1.4% is resolved (z -3.0): the share of the 12-pixel focus that merging
+/// carries is blurred by its disc (a pixel's footprint), as SPPM's -7% and path+splat's -17%
+/// are by theirs; light tracing carries the rest sharp.
 const SPOT_VCM_16: Measured<5> = Measured {
-    bias: [0.0; 5],
-    sd: [0.01; 5],
+    bias: [0.0, 0.0, 0.0, -0.0143, 0.0],
+    sd: [0.0025, 0.0021, 0.0119, 0.0116, 0.0043],
 };
 
 /// The spot-lit box by vertex connection and merging against Mitsuba's light tracer: every

@@ -78,8 +78,8 @@ pub(crate) struct BenchSplat {
     pub(crate) runs: usize,
 }
 
-/// photonflow's sppm, path+splat, path and light against peer renderers at fixed time budgets,
-/// one table per scene.
+/// photonflow's sppm, vcm, path+splat, path and light against peer renderers at fixed time
+/// budgets, one table per scene.
 ///
 /// In one run, every image is scored by its relative MSE against a reference given as two
 /// independent halves, with the reference's noise taken out; per budget the table gives
@@ -106,6 +106,10 @@ pub(crate) struct BenchAccuracy {
     /// Time budgets in seconds, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "2,5,15,60")]
     pub(crate) budgets: Vec<f64>,
+    /// photonflow's methods to run, comma-separated, in the table's order (default: sppm,
+    /// vcm, path+splat, path, light).
+    #[arg(long, value_delimiter = ',')]
+    pub(crate) methods: Vec<scene::Method>,
     /// A peer: NAME, a built-in peer, or NAME=COMMAND, any renderer. Repeatable.
     ///
     /// The built-in peers are tests/references/peer.sh's: mitsuba, mitsuba-ptracer (its
