@@ -38,6 +38,9 @@ pub struct VcmSettings {
     /// Passes: pass `j` traces new subpaths from streams `(seed, j, i)`; the image is their
     /// mean. A time budget sets the passes it made.
     pub passes: u32,
+    /// Light subpaths per pass (0: one per pixel). Pixel `i`'s eye path connects to light
+    /// path `i`; every light path is joined to the camera and merged.
+    pub light_paths: u64,
     /// Merging radius of the first pass in scene units (0: a pixel's footprint at the
     /// distance from the camera to the scene's centre).
     pub radius: f32,
@@ -81,6 +84,7 @@ impl Default for VcmSettings {
     fn default() -> Self {
         VcmSettings {
             passes: 16,
+            light_paths: 0,
             radius: 0.0,
             alpha: 0.75,
             strategies: VcmStrategies::default(),
@@ -616,6 +620,13 @@ impl Settings {
             ));
         }
         let v = &e.vcm;
+        if v.light_paths > 1 << 32 {
+            return Err(format!(
+                "estimate.vcm.light_paths = {} is absurd (at most 2^32: a pass keeps every \
+                 light vertex in memory)",
+                v.light_paths
+            ));
+        }
         if !(v.radius >= 0.0 && v.radius.is_finite()) {
             return Err(format!(
                 "estimate.vcm.radius = {} must be finite and >= 0 (0: automatic)",

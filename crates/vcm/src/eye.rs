@@ -1,7 +1,7 @@
 //! Eye subpaths: one per pixel and pass, gathering from every strategy at each vertex.
 
 use crate::light::LightVertex;
-use crate::{Grid, Pass, SubPath, mis};
+use crate::{Grid, Pass, SubPath, mis, weights};
 use bsdf::{Bsdf, TransportMode};
 use geom::Hit;
 use glam::{DVec3, Vec3};
@@ -66,13 +66,7 @@ fn pixel(scene: &Scene, pass: &Pass, light: &LightSide, index: u64) -> DVec3 {
     let cos = ray.d.normalize().dot(cam.forward());
     // The camera's density per unit solid angle over a pass's pixel samples (`W_e cos`).
     let camera_pdf_w = cam.importance(cos) * cos;
-    let mut path = SubPath {
-        throughput: Vec3::ONE,
-        length: 1,
-        d_vcm: mis(pass.light_paths as f32 / camera_pdf_w),
-        d_vc: 0.0,
-        d_vm: 0.0,
-    };
+    let mut path = SubPath::start(mis(pass.light_paths as f32 / camera_pdf_w), 0.0, 0.0);
     let lights = &scene.light_table;
     let on = pass.opts.strategies;
     let mut sum = DVec3::ZERO;
@@ -108,7 +102,7 @@ fn pixel(scene: &Scene, pass: &Pass, light: &LightSide, index: u64) -> DVec3 {
                 1.0
             } else {
                 let p = lights.emit_pdfs(l, wo);
-                1.0 / (1.0 + mis(p.direct) * path.d_vcm + mis(p.emit) * path.d_vc)
+                weights::hit(path.sums(), p.direct, p.emit, path.direct())
             };
             sum += (path.throughput * le * w).as_dvec3();
         }
@@ -204,7 +198,7 @@ fn escaped(scene: &Scene, path: &SubPath, d: Vec3) -> DVec3 {
             1.0
         } else {
             let p = lights.emit_pdfs(i, -d);
-            1.0 / (1.0 + mis(p.direct) * path.d_vcm + mis(p.emit) * path.d_vc)
+            weights::hit(path.sums(), p.direct, p.emit, path.direct())
         };
         sum += (path.throughput * le * w).as_dvec3();
     }
@@ -232,10 +226,17 @@ fn nee(scene: &Scene, pass: &Pass, path: &SubPath, v: &Vertex, u_pick: f32, u: [
         p.direct
     };
     let bsdf_pdf = if ls.delta { 0.0 } else { dir_pdf };
-    let w_light = mis(bsdf_pdf / direct_w);
-    let w_camera = mis(p.emit * cos / (direct_w * p.cos))
-        * (pass.vm_factor + path.d_vcm + path.d_vc * mis(rev_pdf));
-    let w = 1.0 / (w_light + 1.0 + w_camera);
+    let w = weights::nee(
+        pass,
+        path.sums(),
+        bsdf_pdf,
+        rev_pdf,
+        cos,
+        direct_w,
+        p.emit,
+        p.cos,
+        path.diffuse == 0,
+    );
     let c = f * ls.le * (cos * w / ls.pdf);
     if !(c.is_finite() && c.cmpgt(Vec3::ZERO).any()) {
         return Vec3::ZERO;
@@ -275,9 +276,15 @@ fn connect(scene: &Scene, pass: &Pass, path: &SubPath, v: &Vertex, lv: &LightVer
     // Each side's density of sampling the other's vertex, per unit area there.
     let eye_dir_a = eye_dir * cos_light / dist2;
     let light_dir_a = light_dir * cos_eye / dist2;
-    let w_light = mis(eye_dir_a) * (pass.vm_factor + lv.d_vcm + lv.d_vc * mis(light_rev));
-    let w_camera = mis(light_dir_a) * (pass.vm_factor + path.d_vcm + path.d_vc * mis(eye_rev));
-    let w = 1.0 / (w_light + 1.0 + w_camera);
+    let w = weights::connect(
+        pass,
+        path.sums(),
+        eye_dir_a,
+        eye_rev,
+        lv.sums(),
+        light_dir_a,
+        light_rev,
+    );
     let g = cos_eye * cos_light / dist2;
     let c = (f_eye * f_light * lv.throughput).as_dvec3() * (g * w) as f64;
     if !(c.is_finite() && c.cmpgt(DVec3::ZERO).any()) {
@@ -301,15 +308,16 @@ fn merge(pass: &Pass, path: &SubPath, v: &Vertex, vertices: &[LightVertex], grid
         let Some(lv) = vertices.get(i) else {
             return;
         };
-        if lv.length + path.length > pass.max_len || !grid.within(p, lv.point.p) {
+        // A light vertex one segment from the light is direct light, which NEE and BSDF
+        // sampling alone weigh at the first non-delta eye vertex.
+        let direct = lv.length == 1 && path.diffuse == 0;
+        if direct || lv.length + path.length > pass.max_len || !grid.within(p, lv.point.p) {
             return;
         }
         let Some((f, dir, rev, _)) = v.eval(lv.wo) else {
             return;
         };
-        let w_light = lv.d_vcm * pass.vc_factor + lv.d_vm * mis(dir);
-        let w_camera = path.d_vcm * pass.vc_factor + path.d_vm * mis(rev);
-        let w = 1.0 / (w_light + 1.0 + w_camera);
+        let w = weights::merge(pass, path.sums(), dir, rev, lv.sums());
         let c = (f * lv.throughput).as_dvec3() * w as f64;
         if c.is_finite() {
             sum += c;

@@ -1,7 +1,7 @@
 //! Light subpaths: emitted, traced, their non-delta vertices stored for connections and
 //! merging and joined to the camera (light tracing, the `t = 1` strategy).
 
-use crate::{Pass, SubPath, mis};
+use crate::{Pass, SubPath, mis, weights};
 use bsdf::{Bsdf, TransportMode};
 use geom::{Ray, SurfacePoint};
 use glam::{DVec3, Vec3};
@@ -34,6 +34,16 @@ pub struct LightVertex {
 pub struct CameraSplat {
     pub pixel: u32,
     pub value: DVec3,
+}
+
+impl LightVertex {
+    pub(crate) fn sums(&self) -> weights::Sums {
+        weights::Sums {
+            d_vcm: self.d_vcm,
+            d_vc: self.d_vc,
+            d_vm: self.d_vm,
+        }
+    }
 }
 
 /// Traces light subpaths `range` of `pass`: appends their vertices in path order to
@@ -87,10 +97,7 @@ fn trace(
     };
     let mut path = SubPath {
         throughput,
-        length: 1,
-        d_vcm: mis(pdfs.direct / pdfs.emit),
-        d_vc,
-        d_vm: d_vc * pass.vc_factor,
+        ..SubPath::start(mis(pdfs.direct / pdfs.emit), d_vc, d_vc * pass.vc_factor)
     };
     let mut ray: Ray = e.ray;
     loop {
@@ -120,7 +127,10 @@ fn trace(
                 d_vc: path.d_vc,
                 d_vm: path.d_vm,
             };
+            // A vertex one segment from the light, seen by the camera, is direct light at
+            // the first surface seen: NEE and BSDF sampling weigh it alone.
             if pass.opts.strategies.camera
+                && path.length > 1
                 && path.length < pass.max_len
                 && let Some(s) = to_camera(scene, pass, &v, eye)
             {
@@ -191,11 +201,11 @@ fn to_camera(
     // `W_e cos_e` per unit solid angle (the importance is per pixel), then to area.
     let dist2 = proj.dist * proj.dist;
     let camera_pdf_a = cam.importance(proj.cos) * proj.cos * wi_l.z.abs() / dist2;
-    let n = pass.light_paths as f32;
-    let w_light = mis(camera_pdf_a / n) * (pass.vm_factor + v.d_vcm + v.d_vc * mis(rev));
-    let weight = 1.0 / (1.0 + w_light);
-    let value =
-        v.throughput.as_dvec3() * f.as_dvec3() * (camera_pdf_a as f64 / n as f64) * weight as f64;
+    let weight = weights::camera(pass, v.sums(), camera_pdf_a, rev);
+    let value = v.throughput.as_dvec3()
+        * f.as_dvec3()
+        * (camera_pdf_a as f64 / pass.light_paths as f64)
+        * weight as f64;
     if !(value.is_finite() && value.cmpgt(DVec3::ZERO).any()) {
         return None;
     }

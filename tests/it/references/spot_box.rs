@@ -89,14 +89,14 @@ fn light_tracing_matches_mitsubas_light_tracer_in_the_spot_box() {
 ///
 /// | run | diffuse seen | lit | glass shadow | core | ceiling |
 /// |---|---|---|---|---|---|
-/// | vcm, 16 | +0.06 ± 0.25 | +0.10 ± 0.21 | +0.09 ± 1.19 | -1.43 ± 1.16 | -0.17 ± 0.43 |
+/// | vcm, 16 | +0.02 ± 0.18 | +0.05 ± 0.13 | +0.05 ± 1.19 | -1.43 ± 1.16 | -0.17 ± 0.43 |
 ///
 /// The core's -1.4% is resolved (z -3.0): the share of the 12-pixel focus that merging
 /// carries is blurred by its disc (a pixel's footprint), as SPPM's -7% and path+splat's -17%
 /// are by theirs; light tracing carries the rest sharp.
 const SPOT_VCM_16: Measured<5> = Measured {
     bias: [0.0, 0.0, 0.0, -0.0143, 0.0],
-    sd: [0.0025, 0.0021, 0.0119, 0.0116, 0.0043],
+    sd: [0.0018, 0.0013, 0.0119, 0.0116, 0.0043],
 };
 
 /// The spot-lit box by vertex connection and merging against Mitsuba's light tracer: every

@@ -21,6 +21,7 @@ pub(crate) fn options(run: &Run) -> vcm::Options {
     vcm::Options {
         max_depth: s.render.max_depth,
         rr_depth: s.render.rr_depth,
+        light_paths: v.light_paths,
         radius: if v.radius > 0.0 {
             v.radius
         } else {
@@ -128,7 +129,8 @@ impl<'a> Progressive<'a> {
         };
         let eye =
             |range: std::ops::Range<u64>| (range.start, vcm::eye_paths(scene, &p, &side, range));
-        flow::run_chunks(p.light_paths, &opts, &eye, &mut |(start, px): (
+        let pixels = self.image.len() as u64;
+        flow::run_chunks(pixels, &opts, &eye, &mut |(start, px): (
             u64,
             Vec<DVec3>,
         )| {
