@@ -50,7 +50,7 @@ impl Budget {
 
 /// The techniques the issue names: the path tracer, path + splatted caustics, the global
 /// map shown directly (box and Silverman kernels, + the topological test, + boundary
-/// correction), final gathering, SPPM, and the caustic map against splatting (the `caustic`
+/// correction), final gathering, SPPM, vertex connection and merging, and the caustic map against splatting (the `caustic`
 /// layer alone: `L S+ D E`, caustics seen directly).
 pub fn techniques(quick: bool) -> Vec<Technique> {
     let ladder = |q: &[u64], full: &[u64]| if quick { q.to_vec() } else { full.to_vec() };
@@ -118,6 +118,13 @@ pub fn techniques(quick: bool) -> Vec<Technique> {
         Technique {
             name: "sppm",
             overrides: m(Method::Sppm),
+            budget: Budget::Passes,
+            layer: None,
+            ladder: ladder(&[2, 8], &[4, 16, 64]),
+        },
+        Technique {
+            name: "vcm",
+            overrides: m(Method::Vcm),
             budget: Budget::Passes,
             layer: None,
             ladder: ladder(&[2, 8], &[4, 16, 64]),
