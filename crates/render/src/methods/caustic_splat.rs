@@ -3,14 +3,12 @@
 //! bounces) by photon differential splatting onto eye vertices, with no photon map (the
 //! course framework's `splat_caustics_map`). `[estimate.splat]` holds its knobs.
 
+use super::single_pass::{self, Facts, PassMethod, Passes};
 use crate::rendered::{CountKind, Layer, Rendered};
 use crate::run::Run;
 use crate::settings::{Knob, SplatSettings};
 use crate::splat;
 use film::Class;
-
-/// JSON facts for `image.json`.
-type Facts = serde_json::Map<String, serde_json::Value>;
 
 /// The splatted caustic layers being accumulated pass by pass: each pass makes new eye
 /// vertices (new pixel samples) and new photons, so the mean over passes converges in both.
@@ -186,77 +184,50 @@ impl<'a> Progressive<'a> {
 
 /// Splatting's run as blocks: its passes, one block each.
 pub(super) fn blocks<'a>(run: &'a Run<'a>) -> crate::run::Blocks<'a> {
-    let passes = run.settings.estimate.splat.passes as u64;
-    crate::run::Blocks {
-        acc: Box::new(Progressive::new(run)),
-        blocks: (0..passes).map(|j| j..j + 1).collect(),
-        unit: "passes",
-    }
+    single_pass::blocks(Progressive::new(run))
 }
 
-impl crate::run::Accumulate for Progressive<'_> {
+impl PassMethod for Progressive<'_> {
+    const KNOB: Knob = Knob::SplatPasses;
+    const NAME: &'static str = "splatting";
+
+    fn settings(&self) -> &crate::settings::Settings {
+        self.run.settings
+    }
+
+    fn passes(&self) -> u32 {
+        self.passes
+    }
+
     fn layer_names(&self) -> Vec<String> {
         Progressive::layer_names(self)
     }
 
-    fn block(
+    fn render_pass(
         &mut self,
-        block: std::ops::Range<u64>,
+        pass: u64,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Vec<Vec<glam::DVec3>>, String> {
-        if block.end != block.start + 1 {
-            return Err(format!(
-                "splatting's blocks are single passes, not {block:?}"
-            ));
-        }
-        Progressive::block(self, block.start, progress)
+        Progressive::block(self, pass, progress)
     }
 
-    fn add(&mut self, sums: &[Vec<glam::DVec3>], _passes: u64) {
+    fn add_pass(&mut self, sums: &[Vec<glam::DVec3>]) {
         Progressive::add(self, sums);
     }
 
-    fn finish(&self, seconds: f64) -> Rendered {
-        let mut info = self.facts();
-        info.insert("time_render_s".into(), seconds.into());
-        Rendered {
-            passes: Some(self.passes),
-            ..Rendered::new(self.layers(), info)
-        }
-    }
-}
-
-impl crate::passes::Progressive for Progressive<'_> {
-    fn done(&self) -> u32 {
-        self.passes
-    }
-
-    fn total(&self) -> u32 {
-        self.run.settings.estimate.splat.passes
-    }
-
-    fn limit(&self) -> (u32, String) {
-        (Knob::SplatPasses.max(), Knob::SplatPasses.at_max())
-    }
-
-    /// One photon pass, whatever `_pass` allows: passes are the unit of the mean.
-    fn step(
-        &mut self,
-        _pass: crate::passes::Pass,
-        progress: &(dyn Fn(u64) + Sync),
-    ) -> Result<(), String> {
-        Progressive::step(self, progress)
-    }
-
-    fn layers(&self) -> Vec<Layer> {
+    fn layers_so_far(&self) -> Vec<Layer> {
         Progressive::layers(self)
     }
 
-    fn finish(&self, seconds: f64) -> Rendered {
-        crate::run::Accumulate::finish(self, seconds)
+    fn facts(&self) -> Facts {
+        Progressive::facts(self)
     }
 }
 
 pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
-    crate::passes::run(&mut Progressive::new(run), run.settings.time, progress)
+    crate::passes::run(
+        &mut Passes(Progressive::new(run)),
+        run.settings.time,
+        progress,
+    )
 }

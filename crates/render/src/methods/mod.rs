@@ -12,6 +12,7 @@ mod global_direct;
 mod light;
 pub(crate) mod path;
 mod path_splat;
+mod single_pass;
 pub(crate) mod sppm;
 mod vcm;
 

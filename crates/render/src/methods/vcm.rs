@@ -2,6 +2,7 @@
 //! subpath per pixel (their vertices stored and joined to the camera), builds the merging
 //! grid over them, then one eye subpath per pixel. `[estimate.vcm]` holds its knobs.
 
+use super::single_pass::{self, Facts, PassMethod, Passes};
 use crate::rendered::{CountKind, Layer, Rendered};
 use crate::run::Run;
 use crate::settings::{Knob, VcmSettings};
@@ -169,7 +170,7 @@ impl<'a> Progressive<'a> {
         }]
     }
 
-    fn facts(&self) -> serde_json::Map<String, serde_json::Value> {
+    fn facts(&self) -> Facts {
         let s = &self.run.settings.estimate.vcm;
         let mut info = serde_json::Map::new();
         for (k, v) in [
@@ -195,78 +196,52 @@ impl<'a> Progressive<'a> {
 /// The run as blocks: its passes, one block each (a pass's radius is a function of its
 /// index alone, so any range of passes renders apart).
 pub(super) fn blocks<'a>(run: &'a Run<'a>) -> crate::run::Blocks<'a> {
-    let passes = run.settings.estimate.vcm.passes as u64;
-    crate::run::Blocks {
-        acc: Box::new(Progressive::new(run)),
-        blocks: (0..passes).map(|j| j..j + 1).collect(),
-        unit: "passes",
-    }
+    single_pass::blocks(Progressive::new(run))
 }
 
-impl crate::run::Accumulate for Progressive<'_> {
+impl PassMethod for Progressive<'_> {
+    const KNOB: Knob = Knob::VcmPasses;
+    const NAME: &'static str = "vcm";
+
+    fn settings(&self) -> &crate::settings::Settings {
+        self.run.settings
+    }
+
+    fn passes(&self) -> u32 {
+        self.passes
+    }
+
     fn layer_names(&self) -> Vec<String> {
         vec!["vcm".into()]
     }
 
-    fn block(
+    fn render_pass(
         &mut self,
-        block: std::ops::Range<u64>,
+        pass: u64,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Vec<Vec<DVec3>>, String> {
-        if block.end != block.start + 1 {
-            return Err(format!("vcm's blocks are single passes, not {block:?}"));
-        }
-        Ok(vec![Progressive::block(self, block.start, progress)?])
+        Ok(vec![Progressive::block(self, pass, progress)?])
     }
 
-    fn add(&mut self, sums: &[Vec<DVec3>], _passes: u64) {
+    fn add_pass(&mut self, sums: &[Vec<DVec3>]) {
         if let Some(s) = sums.first() {
             Progressive::add(self, s);
         }
     }
 
-    fn finish(&self, seconds: f64) -> Rendered {
-        let mut info = self.facts();
-        info.insert("time_render_s".into(), seconds.into());
-        Rendered {
-            passes: Some(self.passes),
-            ..Rendered::new(self.layers(), info)
-        }
-    }
-}
-
-impl crate::passes::Progressive for Progressive<'_> {
-    fn done(&self) -> u32 {
-        self.passes
-    }
-
-    fn total(&self) -> u32 {
-        self.run.settings.estimate.vcm.passes
-    }
-
-    fn limit(&self) -> (u32, String) {
-        (Knob::VcmPasses.max(), Knob::VcmPasses.at_max())
-    }
-
-    fn step(
-        &mut self,
-        _pass: crate::passes::Pass,
-        progress: &(dyn Fn(u64) + Sync),
-    ) -> Result<(), String> {
-        let block = self.block(self.passes as u64, progress)?;
-        self.add(&block);
-        Ok(())
-    }
-
-    fn layers(&self) -> Vec<Layer> {
+    fn layers_so_far(&self) -> Vec<Layer> {
         Progressive::layers(self)
     }
 
-    fn finish(&self, seconds: f64) -> Rendered {
-        crate::run::Accumulate::finish(self, seconds)
+    fn facts(&self) -> Facts {
+        Progressive::facts(self)
     }
 }
 
 pub(super) fn render(run: &Run, progress: &(dyn Fn(u64) + Sync)) -> Result<Rendered, String> {
-    crate::passes::run(&mut Progressive::new(run), run.settings.time, progress)
+    crate::passes::run(
+        &mut Passes(Progressive::new(run)),
+        run.settings.time,
+        progress,
+    )
 }
