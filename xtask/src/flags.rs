@@ -62,7 +62,8 @@ cargo xtask <command>   (the photonflow commands build the release `photonflow` 
                       caustic photons splatted per second on 1 and 2 threads, eye vertices,
                       peak memory (default scene: scenes/cornell-spheres/analytic.toml)
   bench accuracy [--case SCENE.toml,REF_A.exr,REF_B.exr]... [--suite FILE] [--refs DIR]
-                 [--budgets 2,5,15,60] [--methods M,...] [--peer NAME | --peer NAME=CMD]...
+                 [--budgets 2,5,15,60] [--methods M,...] [--threads N]
+                 [--peer NAME | --peer NAME=CMD]...
                       photonflow's sppm, vcm, path+splat, path and light and the peers at fixed
                       time budgets, in one run: the relative MSE of each image against the
                       scene's two reference halves, the reference's noise taken out; per

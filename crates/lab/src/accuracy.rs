@@ -142,7 +142,7 @@ pub fn read_suite(path: &Path, refs: Option<&Path>) -> Result<Vec<Case>, String>
 }
 
 /// A peer renderer: a shell command that writes a linear EXR of `$SCENE`'s view to `$OUT` in
-/// about `$BUDGET` seconds. It may print a line `settings: ...` (the table's note says what
+/// about `$BUDGET` seconds (`$THREADS`: `--threads`, 0 for all cores). It may print a line `settings: ...` (the table's note says what
 /// ran); when it fails, its last line on stderr is the reason shown.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Peer {
@@ -289,6 +289,7 @@ fn run_ours(
     out: &Path,
     cache: &Path,
     scoring: &Scoring,
+    threads: Option<usize>,
 ) -> Result<Rung, String> {
     // A photon cache left from another run would make tracing free.
     let _ = std::fs::remove_dir_all(cache);
@@ -303,7 +304,7 @@ fn run_ours(
             },
             cache,
             photons: Photons::TraceOrReuse,
-            threads: None,
+            threads,
             out: out.to_path_buf(),
             exposure: 0.0,
             reference: None,
@@ -349,6 +350,7 @@ fn run_peer(
     budget: f64,
     exr: &Path,
     scoring: &Scoring,
+    threads: Option<usize>,
     note: &mut Option<String>,
 ) -> Result<Rung, String> {
     let _ = std::fs::remove_file(exr);
@@ -359,6 +361,10 @@ fn run_peer(
         .env("OUT", exr)
         .env("BUDGET", budget.to_string())
         .env("SCENE", scene)
+        .env(
+            "THREADS",
+            threads.map_or_else(|| "0".to_string(), |t| t.to_string()),
+        )
         .output()
         .map_err(|e| format!("cannot start: {e}"))?;
     let seconds = t0.elapsed().as_secs_f64();
@@ -388,6 +394,7 @@ pub fn accuracy(
     budgets: &[f64],
     methods: &[Method],
     peers: &[Peer],
+    threads: Option<usize>,
     dir: &Path,
 ) -> Result<(), String> {
     if cases.is_empty() {
@@ -402,8 +409,14 @@ pub fn accuracy(
              methods only)"
         ));
     }
-    if budgets.is_empty() || budgets.iter().any(|b| !(*b > 0.0 && b.is_finite())) {
-        return Err(format!("--budgets {budgets:?}: positive seconds"));
+    if budgets.is_empty() {
+        return Err("--budgets: give at least one budget in seconds".into());
+    }
+    for &b in budgets {
+        render::check_time("--budgets", b)?;
+    }
+    if threads == Some(0) {
+        return Err("--threads must be at least 1".into());
     }
     // Every case's scene and reference halves are checked before anything is written.
     for case in cases {
@@ -461,7 +474,7 @@ pub fn accuracy(
         let mut out_of: Vec<Option<String>> = Vec::new();
         for (p, note) in peers.iter().zip(&mut notes) {
             let exr = case_dir.join(format!("peer-{}-warm-up.exr", p.name));
-            let r = run_peer(p, &scene_abs, smallest, &exr, &scoring, note);
+            let r = run_peer(p, &scene_abs, smallest, &exr, &scoring, threads, note);
             if let Err(e) = &r {
                 println!("{:<14} warm-up: did not run: {e}", p.name);
             }
@@ -470,7 +483,7 @@ pub fn accuracy(
         for &b in budgets {
             for (m, col) in methods.iter().zip(&mut ours) {
                 let out = case_dir.join(format!("{}-{b}s", m.name().replace('+', "-")));
-                let r = run_ours(&scene, *m, b, &out, &cache, &scoring)?;
+                let r = run_ours(&scene, *m, b, &out, &cache, &scoring, threads)?;
                 println!(
                     "{:<14} {b:>5} s budget {:8.2} s  relMSE {:.5}{}",
                     col.name,
@@ -488,7 +501,7 @@ pub fn accuracy(
                     continue;
                 }
                 let exr = case_dir.join(format!("peer-{}-{b}s.exr", p.name));
-                let r = run_peer(p, &scene_abs, b, &exr, &scoring, note);
+                let r = run_peer(p, &scene_abs, b, &exr, &scoring, threads, note);
                 match &r {
                     Ok(r) => println!(
                         "{:<14} {b:>5} s budget {:8.2} s  relMSE {:.5}",

@@ -224,6 +224,7 @@ fn bench_accuracy(a: cli::BenchAccuracy) -> Result<(), String> {
         budgets,
         methods,
         peer,
+        threads,
         dir,
     } = a;
     if let Some(suite) = suite {
@@ -234,7 +235,7 @@ fn bench_accuracy(a: cli::BenchAccuracy) -> Result<(), String> {
     } else {
         methods
     };
-    lab::accuracy::accuracy(&case, &budgets, &methods, &peer, &dir)
+    lab::accuracy::accuracy(&case, &budgets, &methods, &peer, threads, &dir)
 }
 
 fn evidence(a: cli::Evidence) -> Result<(), String> {

@@ -32,7 +32,7 @@ mod tests;
 
 pub use rendered::{Layer, Rendered};
 pub use run::{Photons, Run};
-pub use settings::{EstimateSettings, Overrides, Settings};
+pub use settings::{EstimateSettings, MAX_TIME, Overrides, Settings, check_time};
 
 use flow::Progress;
 use scene::Scene;

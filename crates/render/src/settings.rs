@@ -294,6 +294,27 @@ pub struct Overrides {
     pub time: Option<f64>,
 }
 
+/// The longest time budget a run takes, in seconds: 7 days. Past it no progressive method
+/// reaches its budget before its largest count (2^20 SPPM passes take about 2.6 hours on 2
+/// cores at the worksheet's size), so such a budget only hides a typo; longer runs give a
+/// count.
+pub const MAX_TIME: f64 = 7.0 * 24.0 * 3600.0;
+
+/// The problem with `t` as a time budget given by `flag`, if any.
+pub fn check_time(flag: &str, t: f64) -> Result<(), String> {
+    if !(t > 0.0 && t.is_finite()) {
+        return Err(format!("{flag} {t} must be a positive number of seconds"));
+    }
+    if t > MAX_TIME {
+        // `1e300` as given, not its 301 digits.
+        return Err(format!(
+            "{flag} {t:e} is past the {MAX_TIME} s (7-day) bound on a time budget: give a \
+             count (--passes, --spp) for longer runs"
+        ));
+    }
+    Ok(())
+}
+
 /// `--time`: a budget of seconds for the progressive passes, which run until it is used (at
 /// least one pass runs; the last one ends past it).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -472,10 +493,8 @@ impl Settings {
         if let Some(i) = o.splat_indirect {
             estimate.splat.indirect = i;
         }
-        if let Some(t) = o.time
-            && !(t > 0.0 && t.is_finite())
-        {
-            return Err(format!("--time {t} must be a positive number of seconds"));
+        if let Some(t) = o.time {
+            check_time("--time", t)?;
         }
         if o.time.is_some() && flags.passes.is_none() {
             return Err(format!(

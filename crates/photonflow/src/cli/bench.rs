@@ -119,6 +119,10 @@ pub(crate) struct BenchAccuracy {
     /// in about $BUDGET seconds.
     #[arg(long, value_parser = lab::accuracy::Peer::parse)]
     pub(crate) peer: Vec<lab::accuracy::Peer>,
+    /// Worker threads of photonflow's runs (default: all cores); peers get it as $THREADS
+    /// (0: all cores).
+    #[arg(long)]
+    pub(crate) threads: Option<usize>,
     /// Where runs and peer images go.
     #[arg(long, default_value = "out/bench/accuracy")]
     pub(crate) dir: PathBuf,
