@@ -1,12 +1,13 @@
 //! Eye subpaths: one per pixel and pass, gathering from every strategy at each vertex.
 
 use crate::light::LightVertex;
+use crate::surface::Surface;
 use crate::{Grid, Pass, SubPath, mis, weights};
-use bsdf::{Bsdf, TransportMode};
+use bsdf::TransportMode;
 use geom::Hit;
 use glam::{DVec3, Vec3};
 use math::{Frame, Rng};
-use scene::{Scene, sides_agree};
+use scene::Scene;
 use std::ops::Range;
 
 /// Russian roulette never keeps a path with a higher probability than this (the path
@@ -26,35 +27,10 @@ pub fn eye_paths(scene: &Scene, pass: &Pass, light: &LightSide, range: Range<u64
     range.map(|i| pixel(scene, pass, light, i)).collect()
 }
 
-/// What an eye vertex needs to weigh a strategy: the point, its frame and BSDF, the
-/// direction the path came by.
+/// An eye vertex: the hit (for shadow rays) and its surface.
 struct Vertex<'a> {
     hit: &'a Hit,
-    bsdf: Bsdf,
-    frame: Frame,
-    wo: Vec3,
-    wo_l: Vec3,
-}
-
-impl Vertex<'_> {
-    /// The BSDF towards unit `wi` with its forward density and the reverse one (of sampling
-    /// `wo` given `wi`), and `|cos|` at `wi`; `None` where no light passes.
-    fn eval(&self, wi: Vec3) -> Option<(Vec3, f32, f32, f32)> {
-        let wi_l = self.frame.to_local(wi);
-        if !sides_agree(self.wo, wi, self.hit.point.n, self.wo_l, wi_l) {
-            return None;
-        }
-        let f = self.bsdf.f(self.wo_l, wi_l, TransportMode::Radiance);
-        if f == Vec3::ZERO {
-            return None;
-        }
-        Some((
-            f,
-            self.bsdf.pdf(self.wo_l, wi_l),
-            self.bsdf.pdf(wi_l, self.wo_l),
-            wi_l.z.abs(),
-        ))
-    }
+    surface: Surface,
 }
 
 fn pixel(scene: &Scene, pass: &Pass, light: &LightSide, index: u64) -> DVec3 {
@@ -119,10 +95,14 @@ fn pixel(scene: &Scene, pass: &Pass, light: &LightSide, index: u64) -> DVec3 {
         };
         let v = Vertex {
             hit: &hit,
-            bsdf,
-            frame,
-            wo,
-            wo_l,
+            surface: Surface {
+                bsdf,
+                frame,
+                ng: hit.point.n,
+                wo,
+                wo_l,
+                mode: TransportMode::Radiance,
+            },
         };
         if !bsdf.is_delta() {
             let beta = path.throughput.as_dvec3();
@@ -141,20 +121,8 @@ fn pixel(scene: &Scene, pass: &Pass, light: &LightSide, index: u64) -> DVec3 {
                 sum += beta * merge(pass, &path, &v, light.vertices, grid);
             }
         }
-        if wo_l.z * wo.dot(hit.point.n) <= 0.0 {
+        let Some((wi, s, rev)) = v.surface.sample(u_lobe, u_dir) else {
             break;
-        }
-        let Some(s) = bsdf.sample(wo_l, u_lobe, u_dir, TransportMode::Radiance) else {
-            break;
-        };
-        let wi = frame.to_world(s.wi).normalize();
-        if !sides_agree(wo, wi, hit.point.n, wo_l, s.wi) {
-            break;
-        }
-        let rev = if s.is_specular() {
-            s.pdf
-        } else {
-            bsdf.pdf(s.wi, wo_l)
         };
         path.scatter(&s, rev, pass);
         if s.is_transmission() {
@@ -212,7 +180,7 @@ fn nee(scene: &Scene, pass: &Pass, path: &SubPath, v: &Vertex, u_pick: f32, u: [
     let Some(ls) = lights.sample(v.hit.point.p, u_pick, u) else {
         return Vec3::ZERO;
     };
-    let Some((f, dir_pdf, rev_pdf, cos)) = v.eval(ls.wi) else {
+    let Some(e) = v.surface.eval(ls.wi) else {
         return Vec3::ZERO;
     };
     let p = lights.emit_pdfs(ls.light, -ls.wi);
@@ -225,19 +193,19 @@ fn nee(scene: &Scene, pass: &Pass, path: &SubPath, v: &Vertex, u_pick: f32, u: [
     } else {
         p.direct
     };
-    let bsdf_pdf = if ls.delta { 0.0 } else { dir_pdf };
+    let bsdf_pdf = if ls.delta { 0.0 } else { e.dir };
     let w = weights::nee(
         pass,
         path.sums(),
         bsdf_pdf,
-        rev_pdf,
-        cos,
+        e.rev,
+        e.cos,
         direct_w,
         p.emit,
         p.cos,
         path.diffuse == 0,
     );
-    let c = f * ls.le * (cos * w / ls.pdf);
+    let c = e.f * ls.le * (e.cos * w / ls.pdf);
     if !(c.is_finite() && c.cmpgt(Vec3::ZERO).any()) {
         return Vec3::ZERO;
     }
@@ -258,35 +226,26 @@ fn connect(scene: &Scene, pass: &Pass, path: &SubPath, v: &Vertex, lv: &LightVer
         return DVec3::ZERO;
     }
     let d = to / dist2.sqrt();
-    let Some((f_eye, eye_dir, eye_rev, cos_eye)) = v.eval(d) else {
+    let Some(eye) = v.surface.eval(d) else {
         return DVec3::ZERO;
     };
-    let frame = Frame::from_z(lv.ns);
-    let (wo_l, wi_l) = (frame.to_local(lv.wo), frame.to_local(-d));
-    if !sides_agree(lv.wo, -d, lv.point.n, wo_l, wi_l) {
+    let Some(light) = lv.surface().eval(-d) else {
         return DVec3::ZERO;
-    }
-    let f_light = lv.bsdf.f(wo_l, wi_l, TransportMode::Importance);
-    if f_light == Vec3::ZERO {
-        return DVec3::ZERO;
-    }
-    let cos_light = wi_l.z.abs();
-    let light_dir = lv.bsdf.pdf(wo_l, wi_l);
-    let light_rev = lv.bsdf.pdf(wi_l, wo_l);
+    };
     // Each side's density of sampling the other's vertex, per unit area there.
-    let eye_dir_a = eye_dir * cos_light / dist2;
-    let light_dir_a = light_dir * cos_eye / dist2;
+    let eye_dir_a = eye.dir * light.cos / dist2;
+    let light_dir_a = light.dir * eye.cos / dist2;
     let w = weights::connect(
         pass,
         path.sums(),
         eye_dir_a,
-        eye_rev,
+        eye.rev,
         lv.sums(),
         light_dir_a,
-        light_rev,
+        light.rev,
     );
-    let g = cos_eye * cos_light / dist2;
-    let c = (f_eye * f_light * lv.throughput).as_dvec3() * (g * w) as f64;
+    let g = eye.cos * light.cos / dist2;
+    let c = (eye.f * light.f * lv.throughput).as_dvec3() * (g * w) as f64;
     if !(c.is_finite() && c.cmpgt(DVec3::ZERO).any()) {
         return DVec3::ZERO;
     }
@@ -314,11 +273,11 @@ fn merge(pass: &Pass, path: &SubPath, v: &Vertex, vertices: &[LightVertex], grid
         if direct || lv.length + path.length > pass.max_len || !grid.within(p, lv.point.p) {
             return;
         }
-        let Some((f, dir, rev, _)) = v.eval(lv.wo) else {
+        let Some(e) = v.surface.eval(lv.wo) else {
             return;
         };
-        let w = weights::merge(pass, path.sums(), dir, rev, lv.sums());
-        let c = (f * lv.throughput).as_dvec3() * w as f64;
+        let w = weights::merge(pass, path.sums(), e.dir, e.rev, lv.sums());
+        let c = (e.f * lv.throughput).as_dvec3() * w as f64;
         if c.is_finite() {
             sum += c;
         }

@@ -37,6 +37,7 @@
 mod eye;
 mod grid;
 mod light;
+mod surface;
 #[cfg(test)]
 mod tests;
 mod weights;

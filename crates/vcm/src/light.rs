@@ -1,12 +1,13 @@
 //! Light subpaths: emitted, traced, their non-delta vertices stored for connections and
 //! merging and joined to the camera (light tracing, the `t = 1` strategy).
 
+use crate::surface::Surface;
 use crate::{Pass, SubPath, mis, weights};
 use bsdf::{Bsdf, TransportMode};
 use geom::{Ray, SurfacePoint};
 use glam::{DVec3, Vec3};
 use math::{Frame, Rng};
-use scene::{Scene, sides_agree};
+use scene::Scene;
 use std::ops::Range;
 
 /// A stored light vertex: where a light subpath reached a non-delta surface.
@@ -37,6 +38,17 @@ pub struct CameraSplat {
 }
 
 impl LightVertex {
+    /// Its surface, seen from the light's side.
+    pub(crate) fn surface(&self) -> Surface {
+        Surface::new(
+            self.bsdf,
+            self.ns,
+            self.point.n,
+            self.wo,
+            TransportMode::Importance,
+        )
+    }
+
     pub(crate) fn sums(&self) -> weights::Sums {
         weights::Sums {
             d_vcm: self.d_vcm,
@@ -141,20 +153,16 @@ fn trace(
         if path.length + 2 > pass.max_len {
             return;
         }
-        if wo_l.z * wo.dot(hit.point.n) <= 0.0 {
-            return;
-        }
-        let Some(s) = bsdf.sample(wo_l, uc, u, TransportMode::Importance) else {
-            return;
+        let surface = Surface {
+            bsdf,
+            frame,
+            ng: hit.point.n,
+            wo,
+            wo_l,
+            mode: TransportMode::Importance,
         };
-        let wi = frame.to_world(s.wi).normalize();
-        if !sides_agree(wo, wi, hit.point.n, wo_l, s.wi) {
+        let Some((wi, s, rev)) = surface.sample(uc, u) else {
             return;
-        }
-        let rev = if s.is_specular() {
-            s.pdf
-        } else {
-            bsdf.pdf(s.wi, wo_l)
         };
         let before = path.throughput.max_element();
         path.scatter(&s, rev, pass);
@@ -186,24 +194,14 @@ fn to_camera(
 ) -> Option<CameraSplat> {
     let cam = &scene.camera;
     let proj = cam.project(v.point.p)?;
-    let frame = Frame::from_z(v.ns);
-    let wi = -proj.dir;
-    let (wo_l, wi_l) = (frame.to_local(v.wo), frame.to_local(wi));
-    if !sides_agree(v.wo, wi, v.point.n, wo_l, wi_l) {
-        return None;
-    }
-    let f = v.bsdf.f(wo_l, wi_l, TransportMode::Importance);
-    if f == Vec3::ZERO {
-        return None;
-    }
-    let rev = v.bsdf.pdf(wi_l, wo_l);
+    let e = v.surface().eval(-proj.dir)?;
     // The camera's density of this point per unit area, over all of a pass's pixel samples:
     // `W_e cos_e` per unit solid angle (the importance is per pixel), then to area.
     let dist2 = proj.dist * proj.dist;
-    let camera_pdf_a = cam.importance(proj.cos) * proj.cos * wi_l.z.abs() / dist2;
-    let weight = weights::camera(pass, v.sums(), camera_pdf_a, rev);
+    let camera_pdf_a = cam.importance(proj.cos) * proj.cos * e.cos / dist2;
+    let weight = weights::camera(pass, v.sums(), camera_pdf_a, e.rev);
     let value = v.throughput.as_dvec3()
-        * f.as_dvec3()
+        * e.f.as_dvec3()
         * (camera_pdf_a as f64 / pass.light_paths as f64)
         * weight as f64;
     if !(value.is_finite() && value.cmpgt(DVec3::ZERO).any()) {

@@ -75,24 +75,27 @@ const COLOURED_SPPM_16: [Measured; 3] = [
     },
 ];
 
+/// The regions of `s` (the worksheet's, and the caustic's core) against the reference's
+/// halves, one list per channel.
+fn channel_regions(s: &Scene) -> Vec<Vec<RegionRef>> {
+    let core = ("caustic core", lab::regions::caustic_region(s, 0.8));
+    let masks: Vec<_> = lab::regions::regions(s).into_iter().chain([core]).collect();
+    let (a, b) = (
+        reference_half(COLOURED_REF, "a"),
+        reference_half(COLOURED_REF, "b"),
+    );
+    (0..3)
+        .map(|c| region_refs_of(&channel(&a, c), &channel(&b, c), masks.clone()))
+        .collect()
+}
+
 /// Coloured glass as Mitsuba renders it, channel by channel, by the path tracer and SPPM:
 /// the caustic and the sphere take the glass's colour (`τ²` for light through it). The same
 /// sphere clear fails in the caustic.
 #[test]
 fn coloured_glass_matches_mitsuba_channel_by_channel() {
     let s = coloured(1, |_| {});
-    let core = ("caustic core", lab::regions::caustic_region(&s, 0.8));
-    let masks: Vec<_> = lab::regions::regions(&s)
-        .into_iter()
-        .chain([core])
-        .collect();
-    let (a, b) = (
-        reference_half(COLOURED_REF, "a"),
-        reference_half(COLOURED_REF, "b"),
-    );
-    let regs: Vec<Vec<RegionRef>> = (0..3)
-        .map(|c| region_refs_of(&channel(&a, c), &channel(&b, c), masks.clone()))
-        .collect();
+    let regs = channel_regions(&s);
     let misfits_rgb = |img: &Image, tables: &[Measured; 3]| -> Vec<String> {
         (0..3)
             .flat_map(|c| {
@@ -162,22 +165,13 @@ const COLOURED_VCM_16: [Measured; 3] = [
 #[test]
 fn vcm_matches_mitsuba_through_coloured_glass() {
     let s = coloured(super::table_seed(), |_| {});
-    let core = ("caustic core", lab::regions::caustic_region(&s, 0.8));
-    let masks: Vec<_> = lab::regions::regions(&s)
-        .into_iter()
-        .chain([core])
-        .collect();
-    let (a, b) = (
-        reference_half(COLOURED_REF, "a"),
-        reference_half(COLOURED_REF, "b"),
-    );
+    let regs = channel_regions(&s);
     let img = image_by(&s, Method::Vcm, 16);
     eprintln!("vcm, 16:");
     let mut bad = Vec::new();
     for c in 0..3 {
         eprintln!("  {} channel:", CHANNELS[c]);
-        let regs = region_refs_of(&channel(&a, c), &channel(&b, c), masks.clone());
-        bad.extend(misfits(&channel(&img, c), &regs, &COLOURED_VCM_16[c]));
+        bad.extend(misfits(&channel(&img, c), &regs[c], &COLOURED_VCM_16[c]));
     }
     assert!(bad.is_empty(), "{bad:#?}");
 }

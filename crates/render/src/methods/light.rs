@@ -16,6 +16,14 @@ use glam::DVec3;
 /// Paths per chunk of work: a chunk's contributions wait in memory until it is added.
 const CHUNK: u64 = 4096;
 
+/// Light paths per pass: `[estimate.light] photons`, or `[photons] photons` when it is 0.
+pub(super) fn photons_per_pass(s: &crate::settings::Settings) -> u64 {
+    match s.estimate.light.photons {
+        0 => s.emit.photons,
+        n => n,
+    }
+}
+
 /// The image's f64 sums per class, pass by pass.
 pub(super) struct Progressive<'a> {
     run: &'a Run<'a>,
@@ -29,11 +37,7 @@ pub(super) struct Progressive<'a> {
 
 impl<'a> Progressive<'a> {
     pub(super) fn new(run: &'a Run<'a>) -> Progressive<'a> {
-        let s = run.settings;
-        let photons = match s.estimate.light.photons {
-            0 => s.emit.photons,
-            n => n,
-        };
+        let photons = photons_per_pass(run.settings);
         let pixels = (run.scene.camera.width * run.scene.camera.height) as usize;
         Progressive {
             run,

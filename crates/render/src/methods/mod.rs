@@ -291,13 +291,11 @@ pub fn work(run: &Run) -> (u64, &'static str) {
             (per_pass.saturating_mul(sp.passes as u64), "photons")
         }
         Work::LightPhotons => {
-            let l = &s.estimate.light;
-            let per_pass = if l.photons > 0 {
-                l.photons
-            } else {
-                s.emit.photons
-            };
-            (per_pass.saturating_mul(l.passes as u64), "light paths")
+            let per_pass = light::photons_per_pass(s);
+            (
+                per_pass.saturating_mul(s.estimate.light.passes as u64),
+                "light paths",
+            )
         }
     }
 }

@@ -121,12 +121,17 @@ impl<'a> Progressive<'a> {
                 vertices.len()
             ));
         }
-        let grid = vcm::Grid::build(vertices.iter().map(|v| v.point.p), p.radius);
+        // No grid when merging is switched off: nothing would query it.
+        let grid = self
+            .opts
+            .strategies
+            .merge
+            .then(|| vcm::Grid::build(vertices.iter().map(|v| v.point.p), p.radius));
         let t1 = std::time::Instant::now();
         let side = vcm::LightSide {
             vertices: &vertices,
             starts: &starts,
-            grid: Some(&grid),
+            grid: grid.as_ref(),
         };
         let eye =
             |range: std::ops::Range<u64>| (range.start, vcm::eye_paths(scene, &p, &side, range));
