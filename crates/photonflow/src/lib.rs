@@ -61,7 +61,7 @@ where
             };
         }
     };
-    match run(cli.cmd) {
+    match run(cli.cmd, &cli.define) {
         Ok(()) => (0, None),
         Err(e) => {
             // One line, whatever a library's message holds (a TOML error's excerpt, say).
@@ -71,12 +71,31 @@ where
     }
 }
 
-fn run(cmd: Cmd) -> Result<(), String> {
+/// `-D` parameters, as `(name, value)`.
+type Defines = [(String, String)];
+
+fn run(cmd: Cmd, d: &Defines) -> Result<(), String> {
+    let reads_defines = matches!(
+        cmd,
+        Cmd::Info(_)
+            | Cmd::Convert(_)
+            | Cmd::Render(_)
+            | Cmd::Estimate(_)
+            | Cmd::Trace(_)
+            | Cmd::Worksheet(_)
+    );
+    if let (false, Some((name, _))) = (reads_defines, d.first()) {
+        return Err(format!(
+            "-D {name}=...: only info, convert, render, estimate, trace and worksheet read \
+             scene parameters"
+        ));
+    }
     match cmd {
-        Cmd::Info(a) => info(&a.scene),
+        Cmd::Info(a) => info(&a.scene, d),
+        Cmd::Convert(a) => convert(&a.scene, &a.out, d),
         Cmd::BenchRays(a) => bench_rays(a),
-        Cmd::Render(a) => render_command(a),
-        Cmd::Estimate(a) => estimate(a),
+        Cmd::Render(a) => render_command(a, d),
+        Cmd::Estimate(a) => estimate(a, d),
         Cmd::Composite(cli::Composite {
             inputs,
             out,
@@ -97,8 +116,8 @@ fn run(cmd: Cmd) -> Result<(), String> {
         Cmd::BenchKnn(cli::BenchKnn { photons, queries }) => lab::bench::knn(photons, queries),
         Cmd::BenchAccuracy(a) => bench_accuracy(a),
         Cmd::Evidence(a) => evidence(a),
-        Cmd::Worksheet(a) => worksheet(a),
-        Cmd::Trace(a) => trace(a),
+        Cmd::Worksheet(a) => worksheet(a, d),
+        Cmd::Trace(a) => trace(a, d),
         Cmd::Merge(cli::Merge { inputs, out }) => {
             println!("{}", render::shard::merge(&inputs, &out)?);
             Ok(())
@@ -126,7 +145,7 @@ fn bench_rays(a: cli::BenchRays) -> Result<(), String> {
 }
 
 /// `render`: the run, or with `--shard` one shard of it.
-fn render_command(a: cli::Render) -> Result<(), String> {
+fn render_command(a: cli::Render, d: &Defines) -> Result<(), String> {
     let cli::Render {
         scene,
         method,
@@ -135,7 +154,7 @@ fn render_command(a: cli::Render) -> Result<(), String> {
         no_caustics,
         shard,
     } = a;
-    let s = load(&scene, photon.seed)?;
+    let s = load(&scene, photon.seed, d)?;
     let overrides = Overrides {
         caustics: no_caustics.then_some(false),
         ..photon.overrides(method, image.spp)
@@ -159,7 +178,7 @@ fn render_command(a: cli::Render) -> Result<(), String> {
     )
 }
 
-fn estimate(a: cli::Estimate) -> Result<(), String> {
+fn estimate(a: cli::Estimate, d: &Defines) -> Result<(), String> {
     let cli::Estimate {
         scene,
         method,
@@ -174,7 +193,7 @@ fn estimate(a: cli::Estimate) -> Result<(), String> {
             "estimate reads photon maps: use `render --method {m}` for `{m}`"
         ));
     }
-    let s = load(&scene, photon.seed)?;
+    let s = load(&scene, photon.seed, d)?;
     // A scene whose method reads no photon maps gets the best photon-map method.
     let method = method.unwrap_or(match s.render().method {
         m if reads_maps(m) => m,
@@ -273,7 +292,7 @@ fn evidence(a: cli::Evidence) -> Result<(), String> {
     })
 }
 
-fn worksheet(a: cli::Worksheet) -> Result<(), String> {
+fn worksheet(a: cli::Worksheet, d: &Defines) -> Result<(), String> {
     let cli::Worksheet {
         scene,
         photons,
@@ -284,7 +303,7 @@ fn worksheet(a: cli::Worksheet) -> Result<(), String> {
         cache,
         threads,
     } = a;
-    let s = load(&scene, None)?;
+    let s = load(&scene, None, d)?;
     lab::worksheet::run(
         &s,
         &lab::worksheet::WorksheetArgs {
@@ -301,7 +320,7 @@ fn worksheet(a: cli::Worksheet) -> Result<(), String> {
 }
 
 /// `trace`: the photon sets into the cache, or with `--shard` one shard of them.
-fn trace(a: cli::Trace) -> Result<(), String> {
+fn trace(a: cli::Trace, d: &Defines) -> Result<(), String> {
     let cli::Trace {
         scene,
         seed,
@@ -312,7 +331,7 @@ fn trace(a: cli::Trace) -> Result<(), String> {
         shard,
         out,
     } = a;
-    let s = load(&scene, seed)?;
+    let s = load(&scene, seed, d)?;
     let overrides = Overrides {
         photons,
         ..Overrides::default()
@@ -378,14 +397,68 @@ fn render_shard(
     Ok(())
 }
 
-fn info(path: &Path) -> Result<(), String> {
-    print!("{}", render::describe(&load(path, None)?));
+fn info(path: &Path, d: &Defines) -> Result<(), String> {
+    print!("{}", render::describe(&load(path, None, d)?));
     Ok(())
 }
 
-/// The one load of a command's scene, with `--seed` applied.
-fn load(path: &Path, seed: Option<u64>) -> Result<Scene, String> {
-    let scene = Scene::load_with(path, |f| {
+/// `convert`: the scene file a Mitsuba 3 XML scene means, written whole or not at all, its
+/// file names made relative to where it goes.
+fn convert(xml: &Path, out: &Path, d: &Defines) -> Result<(), String> {
+    if !scene::is_xml(xml) {
+        return Err(format!(
+            "{}: convert reads Mitsuba 3 XML scenes (.xml)",
+            xml.display()
+        ));
+    }
+    let x = scene::read_xml(xml, d).map_err(|e| e.to_string())?;
+    for w in &x.warnings {
+        eprintln!("warning: {w}");
+    }
+    let mut file = x.file;
+    let from = xml.parent().unwrap_or(Path::new(""));
+    let to = out.parent().unwrap_or(Path::new(""));
+    let moved = |p: &mut String| -> Result<(), String> {
+        *p = paths::relative_to(&from.join(&*p), to)?;
+        Ok(())
+    };
+    for m in &mut file.meshes {
+        if let Some(o) = &mut m.obj {
+            moved(o)?;
+        }
+    }
+    for m in file.materials.values_mut() {
+        if let scene::MaterialDesc::Lambertian {
+            texture: Some(t), ..
+        }
+        | scene::MaterialDesc::Glossy {
+            texture: Some(t), ..
+        } = m
+        {
+            moved(t)?;
+        }
+    }
+    for l in &mut file.lights {
+        if let scene::LightDesc::Environment {
+            filename: Some(f), ..
+        } = l
+        {
+            moved(f)?;
+        }
+    }
+    let text = toml::to_string(&file).map_err(|e| format!("internal error: {e}"))?;
+    let text = format!(
+        "# Converted by `photonflow convert` from {}: the scene file it means.\n{text}",
+        xml.file_name().map_or("?".into(), |n| n.to_string_lossy())
+    );
+    paths::write_whole(out, text.as_bytes())?;
+    println!("wrote {}", out.display());
+    Ok(())
+}
+
+/// The one load of a command's scene, with `--seed` and `-D` applied.
+fn load(path: &Path, seed: Option<u64>, d: &Defines) -> Result<Scene, String> {
+    let scene = Scene::load_defined(path, d, |f| {
         if let Some(s) = seed {
             f.seed = s;
         }

@@ -32,3 +32,54 @@ pub fn shard_out(scene: &Path, what: &str, shard: ShardId) -> PathBuf {
         shard.count
     ))
 }
+
+/// `target` as a path relative to the directory `base` (absolute when they share no root).
+pub fn relative_to(target: &Path, base: &Path) -> Result<String, String> {
+    use std::path::Component;
+    let abs = |p: &Path| std::path::absolute(p).map_err(|e| format!("{}: {e}", p.display()));
+    let (t, b) = (abs(target)?, abs(base)?);
+    // Lexical: `a/../b` is not resolved through links, as the scene file resolves it.
+    fn norm(p: &Path) -> Vec<Component<'_>> {
+        let mut out: Vec<Component> = Vec::new();
+        for c in p.components() {
+            match c {
+                Component::CurDir => {}
+                Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                    out.pop();
+                }
+                c => out.push(c),
+            }
+        }
+        out
+    }
+    let (t, b) = (norm(&t), norm(&b));
+    let common = t.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    // Sharing only the root (or a drive): the absolute path reads better than `../../..`.
+    let roots = t
+        .iter()
+        .take_while(|c| matches!(c, Component::Prefix(_) | Component::RootDir))
+        .count();
+    if common <= roots {
+        return Ok(t.iter().collect::<PathBuf>().to_string_lossy().into_owned());
+    }
+    let mut rel = PathBuf::new();
+    for _ in common..b.len() {
+        rel.push("..");
+    }
+    for c in t.iter().skip(common) {
+        rel.push(c);
+    }
+    Ok(rel.to_string_lossy().into_owned())
+}
+
+/// Writes `bytes` to `path` whole or not at all: a temp file beside it, renamed into place.
+pub fn write_whole(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    use std::io::Write;
+    let fail = |e: std::io::Error| format!("{}: cannot write it: {e}", path.display());
+    let (temp, mut f) = temps::Temp::file(path).map_err(fail)?;
+    f.write_all(bytes)
+        .and_then(|()| f.sync_all())
+        .map_err(fail)?;
+    drop(f);
+    temp.publish(path).map_err(fail)
+}

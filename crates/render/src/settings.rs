@@ -742,10 +742,10 @@ impl Settings {
         f.photons = table(toml::Value::try_from(&self.emit))?;
         f.estimate = table(toml::Value::try_from(&self.estimate))?;
         let dir = scene.path.parent().unwrap_or(std::path::Path::new(""));
-        for m in &mut f.meshes {
-            let p = dir.join(&m.obj);
+        for obj in f.meshes.iter_mut().filter_map(|m| m.obj.as_mut()) {
+            let p = dir.join(&*obj);
             let abs = std::path::absolute(&p).map_err(|e| format!("{}: {e}", p.display()))?;
-            m.obj = abs.to_string_lossy().into_owned();
+            *obj = abs.to_string_lossy().into_owned();
         }
         Ok(f)
     }

@@ -251,11 +251,18 @@ impl Default for Scale {
     }
 }
 
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+/// A mesh: an OBJ file (`obj`) or a generated shape (`shape`), placed by scale, rotation,
+/// translation and then `matrix`. New keys are not written back when unset, so the scene
+/// files that predate them keep their hashes.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct MeshDesc {
     /// OBJ file, relative to the scene file.
-    pub obj: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub obj: Option<String>,
+    /// A generated shape instead of a file (Mitsuba 3's `rectangle`, `cube`, `disk`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<ShapeKind>,
     #[serde(default)]
     pub scale: Scale,
     /// Rotation in degrees about x, then y, then z.
@@ -263,10 +270,48 @@ pub struct MeshDesc {
     pub rotate: [f32; 3],
     #[serde(default)]
     pub translate: [f32; 3],
+    /// A 4x4 matrix (rows) applied after scale, rotation and translation: Mitsuba 3's
+    /// `to_world`, as `convert` writes it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub matrix: Option<[[f64; 4]; 4]>,
+    /// A scene-file material for every face, in place of the OBJ's own (whose MTL files
+    /// are then not read).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<String>,
+    /// Emitted radiance (per channel) from the front of every face, the side its winding
+    /// (counter-clockwise) faces: Mitsuba 3's `area` emitter. Needs `material`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radiance: Option<[f32; 3]>,
+    /// Reverses every face (and vertex normal): front and back swap.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub flip_normals: bool,
     #[serde(default)]
     pub emission: EmissionSource,
     #[serde(default)]
     pub normals: NormalMode,
+}
+
+/// Shapes a mesh can be generated as, each in its own space as Mitsuba 3 defines it.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum ShapeKind {
+    /// The square [-1, 1]^2 at z = 0, facing +z.
+    Rectangle,
+    /// The cube [-1, 1]^3, faces outwards.
+    Cube,
+    /// The unit disc at z = 0, facing +z (a fan of 256 triangles of the disc's area: a warning says so).
+    Disk,
+}
+
+impl MeshDesc {
+    /// What the mesh is made from, for messages: its file or its shape.
+    pub fn source(&self) -> String {
+        match (&self.obj, self.shape) {
+            (Some(o), _) => o.clone(),
+            (None, Some(s)) => format!("{s:?}").to_lowercase(),
+            (None, None) => "no source".into(),
+        }
+    }
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]

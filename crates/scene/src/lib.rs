@@ -27,13 +27,14 @@ mod polygon;
 mod scene;
 mod texture;
 mod world;
+mod xml;
 
 pub use camera::{Camera, Projection};
 pub use envmap::EnvMap;
 pub use error::SceneError;
 pub use file::{
     CameraDesc, EmissionSource, LightDesc, MaterialDesc, MeshDesc, Method, NormalMode,
-    RenderSettings, SamplerKind, SceneFile, SphereDesc,
+    RenderSettings, SamplerKind, SceneFile, ShapeKind, SphereDesc,
 };
 pub use lights::{
     AreaLight, Directional, EmitPdfs, Emitted, Environment, Light, LightSample, LightTable,
@@ -44,6 +45,7 @@ pub use material::{ALPHA_RANGE, Material};
 pub use scene::{AlbedoMap, Scene};
 pub use texture::{Texture, srgb_to_linear};
 pub use world::{SPHERE_BIT, bsdf_of, sides_agree, surface_id};
+pub use xml::{XmlScene, is_xml, read_xml};
 
 #[cfg(test)]
 mod tests;

@@ -10,7 +10,7 @@ mod tools;
 pub(crate) use bench::{BenchAccuracy, BenchKnn, BenchPhotons, BenchRays, BenchSplat, BenchStore};
 pub(crate) use rendering::{Estimate, ImageArgs, Merge, PhotonArgs, Render, Trace};
 pub(crate) use studies::{Evidence, Worksheet};
-pub(crate) use tools::{Compare, Composite, Info};
+pub(crate) use tools::{Compare, Composite, Convert, Info};
 
 use clap::{Parser, Subcommand};
 use render::settings::Knob;
@@ -27,6 +27,10 @@ use scene::Method;
 pub(crate) struct Cli {
     #[command(subcommand)]
     pub(crate) cmd: Cmd,
+    /// Sets a Mitsuba 3 XML scene's `$NAME` parameter, before its `<default>`s (repeatable;
+    /// read by info, convert, render, estimate, trace and worksheet).
+    #[arg(short = 'D', global = true, value_name = "NAME=VALUE", value_parser = parse::parse_define)]
+    pub(crate) define: Vec<(String, String)>,
 }
 
 // The commands in the order `photonflow --help` lists them; each one's help is its struct's
@@ -34,6 +38,7 @@ pub(crate) struct Cli {
 #[derive(Subcommand)]
 pub(crate) enum Cmd {
     Info(Info),
+    Convert(Convert),
     BenchRays(BenchRays),
     BenchPhotons(BenchPhotons),
     BenchStore(BenchStore),

@@ -26,3 +26,16 @@ pub(crate) fn parse_rect(s: &str) -> Result<[usize; 4], String> {
         .collect::<Result<_, _>>()?;
     <[usize; 4]>::try_from(v).map_err(|_| "expected x0,y0,x1,y1".to_string())
 }
+
+/// `-D NAME=VALUE`: a parameter name (letters, digits, `_`) and its value.
+pub(crate) fn parse_define(s: &str) -> Result<(String, String), String> {
+    let (name, value) = s
+        .split_once('=')
+        .ok_or_else(|| format!("`{s}`: expected NAME=VALUE"))?;
+    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        return Err(format!(
+            "`{name}`: a parameter name is letters, digits and `_`"
+        ));
+    }
+    Ok((name.to_string(), value.to_string()))
+}

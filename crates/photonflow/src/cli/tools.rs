@@ -8,8 +8,23 @@ use std::path::PathBuf;
 /// materials.
 #[derive(clap::Args)]
 pub(crate) struct Info {
-    /// The scene file (TOML).
+    /// The scene file (TOML) or Mitsuba 3 scene (XML).
     pub(crate) scene: PathBuf,
+}
+
+/// Write the scene file (TOML) a Mitsuba 3 XML scene means: its meshes, textures and
+/// environment maps referenced (relative to the new file), not copied.
+///
+/// What photonflow draws approximately or leaves out is said in `warning:` lines, as
+/// rendering the XML says it; what it cannot draw is refused, naming the file, line and
+/// element.
+#[derive(clap::Args)]
+pub(crate) struct Convert {
+    /// The Mitsuba 3 scene (XML).
+    pub(crate) scene: PathBuf,
+    /// The scene file to write (TOML).
+    #[arg(long)]
+    pub(crate) out: PathBuf,
 }
 
 /// Combine runs of one view: layers of one name averaged by their counts, layers of

@@ -53,7 +53,7 @@ pub(super) fn scene_hashes(file: &SceneFile, files: u64, text: &str) -> (u64, u6
             .meshes
             .iter()
             .map(|m| MeshDesc {
-                obj: String::new(),
+                obj: m.obj.as_ref().map(|_| String::new()),
                 ..m.clone()
             })
             .collect();

@@ -112,6 +112,49 @@ impl Builder<'_> {
         id
     }
 
+    /// The material every face of mesh `index` takes, when the mesh names one: the named
+    /// scene-file material, or with `radiance` a copy of it that emits (its own id, so other
+    /// surfaces of that material stay dark).
+    pub(super) fn mesh_material(
+        &mut self,
+        index: usize,
+        desc: &crate::file::MeshDesc,
+    ) -> Result<Option<u32>, SceneError> {
+        let Some(name) = &desc.material else {
+            return match desc.radiance {
+                Some(_) => Err(self.err(format!(
+                    "mesh {index} ({}): `radiance` needs `material`, the surface that emits",
+                    desc.source()
+                ))),
+                None => Ok(None),
+            };
+        };
+        let Some(&id) = self.by_name.get(name) else {
+            return Err(self.err(format!(
+                "mesh {index} ({}): unknown material `{name}` (the scene file's: {})",
+                desc.source(),
+                self.names.join(", ")
+            )));
+        };
+        let Some(r) = desc.radiance else {
+            return Ok(Some(id));
+        };
+        let le = Vec3::from(r);
+        if !(le.is_finite() && le.min_element() >= 0.0) {
+            return Err(self.err(format!(
+                "mesh {index} ({}): `radiance` {r:?} must be finite and non-negative",
+                desc.source()
+            )));
+        }
+        let m = self.of_material(&self.materials, id)?.clone();
+        let map = *self.of_material(&self.albedo_maps, id)?;
+        let own = self.add_material(&format!("{name} (mesh {index})"), m, le);
+        if let Some(slot) = self.albedo_maps.get_mut(own as usize) {
+            *slot = map;
+        }
+        Ok(Some(own))
+    }
+
     /// Reads the texture at `path` (once per path) and returns its index; `Err` is the
     /// problem, for the caller to name the file that asked for it.
     fn texture(&mut self, path: &Path) -> Result<u32, String> {

@@ -23,6 +23,7 @@ mod lights;
 mod materials;
 mod mtl;
 mod obj;
+mod shapes;
 mod transform;
 
 pub use hash::fnv1a64;
@@ -52,7 +53,34 @@ impl Scene {
         path: impl AsRef<Path>,
         edit: impl FnOnce(&mut SceneFile),
     ) -> Result<Scene, SceneError> {
+        Scene::load_defined(path, &[], edit)
+    }
+
+    /// [`Scene::load_with`] for a scene file or a Mitsuba 3 XML scene (`.xml`), whose
+    /// `$name` parameters `defines` sets (`-D name=value`) before its `<default>`s do.
+    pub fn load_defined(
+        path: impl AsRef<Path>,
+        defines: &[(String, String)],
+        edit: impl FnOnce(&mut SceneFile),
+    ) -> Result<Scene, SceneError> {
         let path = path.as_ref();
+        if crate::xml::is_xml(path) {
+            let xml = crate::xml::read_xml(path, defines)?;
+            let mut file = xml.file;
+            edit(&mut file);
+            // The file it means, as text: its hashes are the TOML scene's.
+            let text = toml::to_string(&file)
+                .map_err(|e| SceneError::new(path, format!("internal error: {e}")))?;
+            let mut scene = Scene::build(path, file, &text)?;
+            scene.warnings.splice(0..0, xml.warnings);
+            return Ok(scene);
+        }
+        if let Some((name, _)) = defines.first() {
+            return Err(SceneError::new(
+                path,
+                format!("-D {name}=...: parameters are for Mitsuba 3 XML scenes (.xml) only"),
+            ));
+        }
         let bytes = read_regular(path)
             .map_err(|e| SceneError::new(path, format!("cannot read scene file: {e}")))?;
         let text = String::from_utf8(bytes)
@@ -78,6 +106,11 @@ impl Scene {
             )
         })?;
         edit(&mut file);
+        Scene::build(path, file, text)
+    }
+
+    /// The scene `file` read from `path` as `text`, built and hashed.
+    fn build(path: &Path, file: SceneFile, text: &str) -> Result<Scene, SceneError> {
         // The builder hashes the files the scene names; the scene text joins per use below.
         let mut hash = Fnv::new();
         let mut scene = Builder::new(path, &file, &mut hash).build(file.clone())?;

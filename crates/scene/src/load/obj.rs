@@ -27,28 +27,60 @@ struct Parsed {
     defined_in: Vec<(PathBuf, Vec<String>)>,
 }
 
+/// Which material a model's faces take: the mesh's own, or their MTL material's id.
+enum Faces<'m> {
+    Own(u32),
+    Mtl(&'m [u32]),
+}
+
 /// Makes a problem with the OBJ file into its error (naming the file and the scene).
 type ObjErr<'e> = &'e dyn Fn(String) -> SceneError;
 
 impl Builder<'_> {
-    /// Mesh `index` of the scene file: read, its materials added, its faces appended.
+    /// Mesh `index` of the scene file: read (or generated), its materials added, its faces
+    /// appended.
     pub(super) fn load_mesh(&mut self, index: usize, desc: &MeshDesc) -> Result<(), SceneError> {
-        let obj_path = self.dir.join(&desc.obj);
+        let own = self.mesh_material(index, desc)?;
+        let xf = transform(desc).ok_or_else(|| {
+            self.err(format!(
+                "mesh {index} ({}): transform must be finite and invertible (a non-zero \
+                 scale; `matrix` affine, its last row 0 0 0 1)",
+                desc.source()
+            ))
+        })?;
+        match (&desc.obj, desc.shape) {
+            (Some(obj), None) => self.load_obj(index, obj, desc, xf, own),
+            (None, Some(kind)) => self.load_shape(index, kind, desc, xf, own),
+            _ => Err(self.err(format!(
+                "mesh {index}: give exactly one of `obj` (a file) and `shape` (rectangle, \
+                 cube, disk)"
+            ))),
+        }
+    }
+
+    fn load_obj(
+        &mut self,
+        index: usize,
+        obj: &str,
+        desc: &MeshDesc,
+        xf: DMat4,
+        own: Option<u32>,
+    ) -> Result<(), SceneError> {
+        let obj_path = self.dir.join(obj);
         // Every problem below names the file at fault and, after it, the scene that uses it.
         let of = format!("mesh {index} of {}", self.scene_path.display());
         let oerr = |problem: String| SceneError::new(&obj_path, format!("{problem} ({of})"));
-        let parsed = self.parse_obj(index, &obj_path, &of, &oerr)?;
+        // A mesh given its own material reads no MTL file: every face is that material.
+        let parsed = self.parse_obj(index, &obj_path, &of, own.is_none(), &oerr)?;
         let mat_ids = self.mtl_materials(&parsed, &obj_path, desc.emission)?;
         self.validate_materials().map_err(|e| oerr(e.problem))?;
-        check_faces(&parsed, &oerr)?;
-        let xf = transform(desc).ok_or_else(|| {
-            self.err(format!(
-                "mesh {index} ({}): transform must be finite with a non-zero scale",
-                desc.obj
-            ))
-        })?;
+        check_faces(&parsed, own.is_none(), &oerr)?;
+        let faces = match own {
+            Some(id) => Faces::Own(id),
+            None => Faces::Mtl(&mat_ids),
+        };
         for model in &parsed.models {
-            self.append_model(model, desc, xf, &mat_ids, &obj_path, &oerr)?;
+            self.append_model(model, desc, xf, &faces, &obj_path, &oerr)?;
         }
         Ok(())
     }
@@ -59,6 +91,7 @@ impl Builder<'_> {
         index: usize,
         obj_path: &Path,
         of: &str,
+        read_mtl: bool,
         oerr: ObjErr,
     ) -> Result<Parsed, SceneError> {
         let bytes = read_regular(obj_path).map_err(|e| {
@@ -91,6 +124,9 @@ impl Builder<'_> {
                 ignore_lines: true,
             },
             |p| {
+                if !read_mtl {
+                    return Ok(Default::default());
+                }
                 let mtl_path = obj_dir.join(p);
                 match read_regular(&mtl_path) {
                     Ok(b) => {
@@ -233,7 +269,7 @@ impl Builder<'_> {
         model: &tobj::Model,
         desc: &MeshDesc,
         xf: DMat4,
-        mat_ids: &[u32],
+        faces: &Faces,
         obj_path: &Path,
         oerr: ObjErr,
     ) -> Result<(), SceneError> {
@@ -282,15 +318,18 @@ impl Builder<'_> {
                 part.normals.push(n.as_vec3());
             }
         }
-        let mat = match m.material_id.map(|i| (i, mat_ids.get(i))) {
-            Some((_, Some(&id))) => id,
-            Some((i, None)) => {
-                return Err(oerr(format!(
-                    "object `{}` uses material index {i} that its MTL does not define",
-                    model.name
-                )));
-            }
-            None => {
+        let mat = match (faces, m.material_id) {
+            (Faces::Own(id), _) => *id,
+            (Faces::Mtl(ids), Some(i)) => match ids.get(i) {
+                Some(&id) => id,
+                None => {
+                    return Err(oerr(format!(
+                        "object `{}` uses material index {i} that its MTL does not define",
+                        model.name
+                    )));
+                }
+            },
+            (Faces::Mtl(_), None) => {
                 return Err(oerr(format!(
                     "object `{}` has faces before any `usemtl` line, so they have no material",
                     model.name
@@ -353,6 +392,9 @@ impl Builder<'_> {
         if desc.normals == NormalMode::Smooth {
             part.normals = smooth_vertex_normals(&part.positions, &part.indices);
         }
+        if desc.flip_normals {
+            super::shapes::flip(&mut part);
+        }
         self.mesh.append(&part);
         Ok(())
     }
@@ -360,7 +402,7 @@ impl Builder<'_> {
 
 /// Each way a face can lack a material has its own message (tobj reports all of them as a
 /// model without a material id); a file without faces is refused.
-fn check_faces(parsed: &Parsed, oerr: ObjErr) -> Result<(), SceneError> {
+fn check_faces(parsed: &Parsed, materials_used: bool, oerr: ObjErr) -> Result<(), SceneError> {
     let Parsed {
         bytes,
         models,
@@ -370,7 +412,7 @@ fn check_faces(parsed: &Parsed, oerr: ObjErr) -> Result<(), SceneError> {
     } = parsed;
     let directives = obj_directives(bytes);
     for (line, name) in &directives.usemtl {
-        if materials.iter().any(|m| &m.name == name) {
+        if !materials_used || materials.iter().any(|m| &m.name == name) {
             continue;
         }
         return Err(oerr(if mtl_files.is_empty() {

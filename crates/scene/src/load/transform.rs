@@ -33,8 +33,8 @@ pub(super) fn rotation(degrees: [f32; 3]) -> Option<DMat3> {
     ))
 }
 
-/// A mesh's transform: scale, then [`rotation`], then translate. `None` unless finite with a
-/// non-zero scale.
+/// A mesh's transform: scale, then [`rotation`], then translate, then `matrix`. `None`
+/// unless finite and invertible.
 pub(super) fn transform(d: &MeshDesc) -> Option<DMat4> {
     let s = match d.scale {
         Scale::Uniform(s) => DVec3::splat(s as f64),
@@ -49,5 +49,15 @@ pub(super) fn transform(d: &MeshDesc) -> Option<DMat4> {
         return None;
     }
     let rot = rotation(d.rotate)?;
-    Some(DMat4::from_translation(t) * DMat4::from_mat3(rot * DMat3::from_diagonal(s)))
+    let trs = DMat4::from_translation(t) * DMat4::from_mat3(rot * DMat3::from_diagonal(s));
+    match d.matrix {
+        None => Some(trs),
+        Some(rows) => {
+            let m = DMat4::from_cols_array_2d(&rows).transpose();
+            let linear = DMat3::from_mat4(m).determinant();
+            // The last row must be (0, 0, 0, 1): a projective matrix places no mesh.
+            let affine = rows[3] == [0.0, 0.0, 0.0, 1.0];
+            (m.is_finite() && affine && linear != 0.0 && linear.is_finite()).then_some(m * trs)
+        }
+    }
 }

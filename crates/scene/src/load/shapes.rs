@@ -1,0 +1,168 @@
+//! Meshes generated rather than read: Mitsuba 3's `rectangle`, `cube` and `disk`, each in
+//! its own space as Mitsuba defines it, placed by the mesh's transform.
+
+use super::{Builder, MAX_COORD};
+use crate::error::SceneError;
+use crate::file::{MeshDesc, ShapeKind};
+use geom::TriMesh;
+use glam::{DMat4, DVec3, Vec2, Vec3};
+
+/// Segments of a disk's fan. Its radius is stretched so the polygon has the disc's area
+/// (`n/2 sin(2 pi / n) r'^2 = pi r^2`): an emitting disk keeps its power exactly.
+const DISK_SEGMENTS: u32 = 256;
+
+impl Builder<'_> {
+    /// Mesh `index`, a generated shape of material `own`, appended through `xf`.
+    pub(super) fn load_shape(
+        &mut self,
+        index: usize,
+        kind: ShapeKind,
+        desc: &MeshDesc,
+        xf: DMat4,
+        own: Option<u32>,
+    ) -> Result<(), SceneError> {
+        let Some(mat) = own else {
+            return Err(self.err(format!(
+                "mesh {index} ({}): a generated shape needs `material` (it has no MTL)",
+                desc.source()
+            )));
+        };
+        let mut part = local(kind);
+        if kind == ShapeKind::Disk {
+            self.warnings.push(format!(
+                "{}: mesh {index} (disk): drawn as a {DISK_SEGMENTS}-sided polygon of the \
+                 disc's area",
+                self.scene_path.display()
+            ));
+        }
+        for p in &mut part.positions {
+            let q = xf.transform_point3(p.as_dvec3());
+            if !q.is_finite() || q.abs().max_element() > MAX_COORD {
+                return Err(self.err(format!(
+                    "mesh {index} ({}): a vertex lies at {:?} after the transform, beyond the \
+                     {MAX_COORD:e} scene units photonflow can trace",
+                    desc.source(),
+                    q.to_array()
+                )));
+            }
+            *p = q.as_vec3();
+        }
+        if desc.flip_normals {
+            flip(&mut part);
+        }
+        part.materials = vec![mat; part.indices.len()];
+        self.mesh.append(&part);
+        Ok(())
+    }
+}
+
+/// Turns every face over: winding reversed, vertex normals negated.
+pub(super) fn flip(part: &mut TriMesh) {
+    for t in &mut part.indices {
+        t.swap(1, 2);
+    }
+    for n in &mut part.normals {
+        *n = -*n;
+    }
+}
+
+/// The shape in its own space: flat-shaded triangles wound towards the front.
+fn local(kind: ShapeKind) -> TriMesh {
+    let mut m = TriMesh::default();
+    let quad = |m: &mut TriMesh, corners: [DVec3; 4]| {
+        let base = m.positions.len() as u32;
+        for (c, uv) in corners.iter().zip([[0., 0.], [1., 0.], [1., 1.], [0., 1.]]) {
+            m.positions.push(c.as_vec3());
+            m.texcoords.push(Vec2::from(uv));
+        }
+        m.indices.push([base, base + 1, base + 2]);
+        m.indices.push([base, base + 2, base + 3]);
+    };
+    match kind {
+        ShapeKind::Rectangle => quad(
+            &mut m,
+            [
+                DVec3::new(-1., -1., 0.),
+                DVec3::new(1., -1., 0.),
+                DVec3::new(1., 1., 0.),
+                DVec3::new(-1., 1., 0.),
+            ],
+        ),
+        ShapeKind::Cube => {
+            // Each face: its outward normal n and two axes u, v with u x v = n.
+            for n in [
+                DVec3::X,
+                DVec3::Y,
+                DVec3::Z,
+                -DVec3::X,
+                -DVec3::Y,
+                -DVec3::Z,
+            ] {
+                let u = if n.x != 0.0 { DVec3::Y } else { DVec3::X };
+                let v = n.cross(u);
+                quad(&mut m, [n - u - v, n + u - v, n + u + v, n - u + v]);
+            }
+        }
+        ShapeKind::Disk => {
+            let n = DISK_SEGMENTS as f64;
+            let step = std::f64::consts::TAU / n;
+            let r = (std::f64::consts::PI / (0.5 * n * step.sin())).sqrt();
+            m.positions.push(Vec3::ZERO);
+            for i in 0..DISK_SEGMENTS {
+                let a = i as f64 * step;
+                m.positions
+                    .push(DVec3::new(r * a.cos(), r * a.sin(), 0.0).as_vec3());
+                let next = 1 + (i + 1) % DISK_SEGMENTS;
+                m.indices.push([0, 1 + i, next]);
+            }
+        }
+    }
+    m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn area_and_normal_sum(m: &TriMesh) -> (f64, DVec3) {
+        let mut area = 0.0;
+        let mut n = DVec3::ZERO;
+        for t in &m.indices {
+            let [a, b, c] = t.map(|i| m.positions[i as usize].as_dvec3());
+            let cr = (b - a).cross(c - a);
+            area += cr.length() / 2.0;
+            n += cr / 2.0;
+        }
+        (area, n)
+    }
+
+    #[test]
+    fn shapes_have_their_areas_and_face_outwards() {
+        // Rectangle [-1, 1]^2: area 4 facing +z.
+        let (a, n) = area_and_normal_sum(&local(ShapeKind::Rectangle));
+        assert!((a - 4.0).abs() < 1e-6 && (n - DVec3::new(0., 0., 4.)).length() < 1e-6);
+        // Disk: area pi (the fan is stretched to it), facing +z.
+        let (a, n) = area_and_normal_sum(&local(ShapeKind::Disk));
+        assert!((a - std::f64::consts::PI).abs() < 1e-5, "{a}");
+        assert!((n.z - a).abs() < 1e-9);
+        // Cube [-1, 1]^3: area 24, closed (normals sum to zero), every face outwards: its
+        // centre plus its normal lies farther from the origin.
+        let cube = local(ShapeKind::Cube);
+        let (a, n) = area_and_normal_sum(&cube);
+        assert!((a - 24.0).abs() < 1e-6 && n.length() < 1e-6);
+        for t in &cube.indices {
+            let [p, q, r] = t.map(|i| cube.positions[i as usize].as_dvec3());
+            let c = (p + q + r) / 3.0;
+            let nn = (q - p).cross(r - p).normalize();
+            assert!((c + nn).length() > c.length(), "face {t:?} faces inwards");
+        }
+    }
+
+    #[test]
+    fn flip_turns_faces_over() {
+        let mut m = local(ShapeKind::Rectangle);
+        flip(&mut m);
+        let (_, n) = area_and_normal_sum(&m);
+        assert!((n - DVec3::new(0., 0., -4.)).length() < 1e-6);
+    }
+}
