@@ -26,6 +26,7 @@ mod photon_files;
 mod scene_file;
 mod shards;
 mod temp_files;
+mod xml;
 
 use crate::kit::{TempDir, cli};
 use film::Image;
