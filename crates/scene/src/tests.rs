@@ -26,6 +26,8 @@ mod scene_file;
 mod scenes;
 /// Textures: decoding, filtering, `map_Kd` and its errors.
 mod textures;
+/// Mitsuba 3 XML scenes: transforms against Mitsuba's, the worksheet in XML, parameters.
+mod xml;
 
 fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")

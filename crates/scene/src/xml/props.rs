@@ -314,20 +314,26 @@ pub(super) fn transform(t: &Elem) -> Result<DMat4, SceneError> {
                 DMat4::from_scale(s)
             }
             "rotate" => {
-                let axis = match op.attr("axis") {
-                    Some(a) => match numbers(op, a)?.as_slice() {
-                        [x, y, z] => DVec3::new(*x, *y, *z),
-                        _ => return Err(op.err("`axis` needs three numbers")),
-                    },
-                    None => vec3(op, 0.0)?,
-                };
-                let angle = number(op, "angle")?;
-                let axis = axis
-                    .try_normalize()
-                    .ok_or_else(|| op.err("the axis is zero"))?;
+                // The axis by `x`, `y`, `z` (Mitsuba 3 reads no `axis` attribute), taken as
+                // written: Mitsuba's `Transform4f::rotate` is Rodrigues' formula
+                // `cos I + sin [a]x + (1 - cos) a a^T` without normalising `a`, so an axis
+                // of length other than 1 scales and shears, there and here alike.
+                let a = vec3(op, 0.0)?;
+                if a == DVec3::ZERO {
+                    return Err(op.err("the axis is zero"));
+                }
+                let (sin, cos) = number(op, "angle")?.to_radians().sin_cos();
+                let cross = DMat3::from_cols(
+                    DVec3::new(0.0, a.z, -a.y),
+                    DVec3::new(-a.z, 0.0, a.x),
+                    DVec3::new(a.y, -a.x, 0.0),
+                );
+                let outer = DMat3::from_cols(a * a.x, a * a.y, a * a.z);
+                let rot =
+                    DMat3::from_diagonal(DVec3::splat(cos)) + cross * sin + outer * (1.0 - cos);
                 // Entries within 1e-12 of 0 or +-1 snapped, as the scene file's `rotate`
                 // does: a turn of 90 or 180 degrees keeps axis-aligned walls exact.
-                let r = DMat3::from_axis_angle(axis, angle.to_radians()).to_cols_array();
+                let r = rot.to_cols_array();
                 DMat4::from_mat3(DMat3::from_cols_array(&r.map(|x| {
                     if x.abs() < 1e-12 {
                         0.0
