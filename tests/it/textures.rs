@@ -16,7 +16,8 @@ fn floor_of(dir: &TempDir, texture: Option<&str>, albedo: [f32; 3]) -> scene::Sc
             MaterialDesc::Lambertian {
                 albedo,
                 emission: [0.0; 3],
-                texture: texture.map(|t| dir.path().join(t).display().to_string()),
+                texture: texture
+                    .map(|t| scene::TextureDesc::File(dir.path().join(t).display().to_string())),
             },
         );
     })

@@ -12,7 +12,8 @@
 #             and draws different random numbers, so its images differ within noise
 # NAME        cornell-spheres-analytic, cornell-spheres-closeup, cornell-glossy, cornell-rough,
 #             cornell-textured, cornell-coloured-glass, furnace, plane-light, corner,
-#             point-caustic, cornell-spot, environment, mcguire-original (default: all)
+#             point-caustic, cornell-spot, environment, mcguire-original, mitsuba-worksheet,
+#             mitsuba-shapes-and-lights (default: all)
 # SPP_POINT, SPP_SPOT, SPP_ENV  spp per half of point-caustic, cornell-spot, environment
 #             (default 24576, 8192, 24576)
 # BENCH=1     the benchmark references instead of the test ones, for the NAMEs that have
@@ -115,6 +116,18 @@ for fa in sorted(glob.glob(os.path.join(sys.argv[2], "*-a.exr"))):
 EOF
 }
 
+# Two halves of a Mitsuba XML scene of scenes/mitsuba/, rendered from the file itself by
+# mitsuba_xml.py (its $width, $height and $spp set). render_xml NAME SCENE.xml W H SPP SPP_PER_PASS
+render_xml() {
+  local name=$1 xml=$2 w=$3 h=$4 spp=$5 pp=$6 half seed
+  for half in ${HALVES:-a b}; do
+    if [ $half = a ]; then seed=$SEED_A; else seed=$SEED_B; fi
+    echo "== $name ${w}x$h half $half: seed $seed, $spp spp, the XML's integrator"
+    "$PY" "$HERE/mitsuba_xml.py" "$PEERS" "$xml" --width "$w" --height "$h" --spp "$spp" \
+      --spp-per-pass "$pp" --seed "$seed" --variant "$VARIANT" -o "$OUT/$name-${w}x$h-$half.exr"
+  done
+}
+
 # spp per half of the light-lit scenes (overridable for quick looks)
 SPP_POINT=${SPP_POINT:-24576}
 SPP_SPOT=${SPP_SPOT:-8192}
@@ -122,7 +135,7 @@ SPP_ENV=${SPP_ENV:-24576}
 P=$PEERS/worksheet
 S=$REPO/scenes
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough cornell-textured cornell-coloured-glass furnace plane-light corner point-caustic cornell-spot environment mcguire-original)
+[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough cornell-textured cornell-coloured-glass furnace plane-light corner point-caustic cornell-spot environment mcguire-original mitsuba-worksheet mitsuba-shapes-and-lights)
 if [ "$BENCH" = 1 ]; then
   for n in "${names[@]}"; do
     case $n in
@@ -182,6 +195,10 @@ for n in "${names[@]}"; do
     environment)
       render $n obj-spheres "$S/environment/env-only.toml" 128 128 $SPP_ENV 1024 \
         "$S/environment/floor.obj" --spheres "$TMP/$n-128x128-spheres.json" ;;
+    mitsuba-worksheet)
+      render_xml $n "$S/mitsuba/worksheet.xml" 128 128 4096 1024 ;;
+    mitsuba-shapes-and-lights)
+      render_xml $n "$S/mitsuba/shapes-and-lights.xml" 128 128 4096 1024 ;;
     stats) stats ;;
     *) echo "unknown NAME $n" >&2; exit 2 ;;
   esac

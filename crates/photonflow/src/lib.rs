@@ -429,10 +429,12 @@ fn convert(xml: &Path, out: &Path, d: &Defines) -> Result<(), String> {
     }
     for m in file.materials.values_mut() {
         if let scene::MaterialDesc::Lambertian {
-            texture: Some(t), ..
+            texture: Some(scene::TextureDesc::File(t)),
+            ..
         }
         | scene::MaterialDesc::Glossy {
-            texture: Some(t), ..
+            texture: Some(scene::TextureDesc::File(t)),
+            ..
         } = m
         {
             moved(t)?;

@@ -399,10 +399,10 @@ pub enum MaterialDesc {
         albedo: [f32; 3],
         #[serde(default)]
         emission: [f32; 3],
-        /// An albedo texture (PNG, JPEG, TGA or EXR, relative to the scene file) that
-        /// `albedo` multiplies, as MTL's `Kd` multiplies `map_Kd`.
+        /// An albedo texture that `albedo` multiplies, as MTL's `Kd` multiplies `map_Kd`: an
+        /// image (PNG, JPEG, TGA or EXR, relative to the scene file) or a checkerboard.
         #[serde(default, skip_serializing_if = "Option::is_none")]
-        texture: Option<String>,
+        texture: Option<TextureDesc>,
     },
     Mirror {
         #[serde(default = "one3")]
@@ -429,7 +429,7 @@ pub enum MaterialDesc {
         alpha: f32,
         /// An albedo texture for the Lambertian part, as `lambertian`'s.
         #[serde(default, skip_serializing_if = "Option::is_none")]
-        texture: Option<String>,
+        texture: Option<TextureDesc>,
     },
     /// A rough metal (GGX, roughness `alpha`): reflectance `reflectance` times the Fresnel
     /// term of the complex index `eta + i k` where both are given, else times 1 (Mitsuba 3's
@@ -453,6 +453,51 @@ pub enum MaterialDesc {
         #[serde(default, skip_serializing_if = "is_zero3")]
         absorption: [f32; 3],
     },
+}
+
+/// A material's albedo texture: an image file's name, or a table for a procedural one.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum TextureDesc {
+    /// An image, relative to the scene file.
+    File(String),
+    Checkerboard(CheckerboardDesc),
+}
+
+/// Mitsuba 3's `checkerboard`: `color0` where the fractional parts of the texture
+/// coordinates (after `to_uv`) are both below or both above one half, `color1` elsewhere
+/// (`texture = { type = "checkerboard", ... }`).
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CheckerboardDesc {
+    #[serde(rename = "type")]
+    pub kind: CheckerboardKind,
+    #[serde(default = "checker0")]
+    pub color0: [f32; 3],
+    #[serde(default = "checker1")]
+    pub color1: [f32; 3],
+    /// Rows of the affine map from the surface's texture coordinates (as Mitsuba gives them:
+    /// `v = 0` at an image's top) to the pattern's.
+    #[serde(default = "identity_uv")]
+    pub to_uv: [[f32; 3]; 2],
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum CheckerboardKind {
+    Checkerboard,
+}
+
+fn checker0() -> [f32; 3] {
+    [0.4; 3]
+}
+
+fn checker1() -> [f32; 3] {
+    [0.2; 3]
+}
+
+fn identity_uv() -> [[f32; 3]; 2] {
+    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
 }
 
 fn one3() -> [f32; 3] {

@@ -33,8 +33,9 @@ pub use camera::{Camera, Projection};
 pub use envmap::EnvMap;
 pub use error::SceneError;
 pub use file::{
-    CameraDesc, EmissionSource, LightDesc, MaterialDesc, MeshDesc, Method, NormalMode,
-    RenderSettings, SamplerKind, SceneFile, ShapeKind, SphereDesc,
+    CameraDesc, CheckerboardDesc, CheckerboardKind, EmissionSource, LightDesc, MaterialDesc,
+    MeshDesc, Method, NormalMode, RenderSettings, SamplerKind, SceneFile, ShapeKind, SphereDesc,
+    TextureDesc,
 };
 pub use lights::{
     AreaLight, Directional, EmitPdfs, Emitted, Environment, Light, LightSample, LightTable,
@@ -43,7 +44,7 @@ pub use lights::{
 pub use load::fnv1a64;
 pub use material::{ALPHA_RANGE, Material};
 pub use scene::{AlbedoMap, Scene};
-pub use texture::{Texture, srgb_to_linear};
+pub use texture::{Checkerboard, Texture, srgb_to_linear};
 pub use world::{SPHERE_BIT, bsdf_of, sides_agree, surface_id};
 pub use xml::{XmlScene, is_xml, read_xml};
 

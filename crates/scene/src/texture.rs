@@ -23,12 +23,24 @@ use std::path::Path;
 /// beyond any albedo map a scene needs; a larger header is taken for a damaged file.
 const MAX_TEXELS: u64 = 1 << 26;
 
-/// A linear-RGB image, row 0 at the top (as files store them).
+/// A linear-RGB image, row 0 at the top (as files store them), or a checkerboard (whose
+/// two colours are then its texels).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Texture {
     pub width: usize,
     pub height: usize,
     pub texels: Vec<Vec3>,
+    pub checker: Option<Checkerboard>,
+}
+
+/// Mitsuba 3's `checkerboard` texture: `color0` where the fractional parts of `to_uv` times
+/// the texture coordinate are both below or both above 1/2, `color1` elsewhere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Checkerboard {
+    pub color0: Vec3,
+    pub color1: Vec3,
+    /// Rows of the affine map, on Mitsuba's coordinates (`v = 0` at an image's top).
+    pub to_uv: [[f32; 3]; 2],
 }
 
 /// The sRGB transfer function's inverse (IEC 61966-2-1), per channel.
@@ -106,7 +118,18 @@ impl Texture {
             width: rgb.width() as usize,
             height: rgb.height() as usize,
             texels,
+            checker: None,
         })
+    }
+
+    /// A checkerboard of two colours.
+    pub fn checkerboard(c: Checkerboard) -> Texture {
+        Texture {
+            width: 2,
+            height: 1,
+            texels: vec![c.color0, c.color1],
+            checker: Some(c),
+        }
     }
 
     /// The largest value of each channel over the texture.
@@ -118,6 +141,19 @@ impl Texture {
     /// image (OBJ's convention: `v = 0` is the bottom row); texel centres lie at half-integer
     /// coordinates (Mitsuba 3's `bitmap`: `filter_type = bilinear`, `wrap_mode = repeat`).
     pub fn eval(&self, uv: Vec2) -> Vec3 {
+        if let Some(c) = &self.checker {
+            // Mitsuba's v runs down the image: photonflow's, as OBJ's `vt`, up.
+            let (u, v) = (uv.x, 1.0 - uv.y);
+            let [a, b] = c.to_uv;
+            let s = a[0] * u + a[1] * v + a[2];
+            let t = b[0] * u + b[1] * v + b[2];
+            let upper = |x: f32| x - x.floor() > 0.5;
+            return if upper(s) == upper(t) {
+                c.color0
+            } else {
+                c.color1
+            };
+        }
         let x = uv.x * self.width as f32 - 0.5;
         let y = (1.0 - uv.y) * self.height as f32 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());

@@ -26,6 +26,7 @@
 mod closeup;
 mod coloured_glass;
 mod environment;
+mod gallery;
 mod glossy;
 mod mcguire;
 mod point_caustic;

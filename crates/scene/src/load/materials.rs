@@ -5,10 +5,11 @@ use super::Builder;
 use crate::error::SceneError;
 use crate::file::MaterialDesc;
 use crate::file::SceneFile;
+use crate::file::TextureDesc;
 use crate::material::ALPHA_RANGE;
 use crate::material::Material;
 use crate::scene::AlbedoMap;
-use crate::texture::Texture;
+use crate::texture::{Checkerboard, Texture};
 use glam::Vec3;
 use std::path::Path;
 
@@ -155,9 +156,26 @@ impl Builder<'_> {
         Ok(Some(own))
     }
 
-    /// Reads the texture at `path` (once per path) and returns its index; `Err` is the
+    /// The texture of `source` (an image read once per path) as its index; `Err` is the
     /// problem, for the caller to name the file that asked for it.
-    fn texture(&mut self, path: &Path) -> Result<u32, String> {
+    fn texture(&mut self, source: Source) -> Result<u32, String> {
+        let path = match source {
+            Source::File(p) => p,
+            Source::Checker(c) => {
+                let v = [c.color0, c.color1];
+                if !v.iter().all(|c| c.is_finite() && c.min_element() >= 0.0)
+                    || !c.to_uv.iter().flatten().all(|x| x.is_finite())
+                {
+                    return Err(format!(
+                        "a checkerboard's colours must be finite and >= 0 and its to_uv finite \
+                         (got {:?}, {:?}, {:?})",
+                        c.color0, c.color1, c.to_uv
+                    ));
+                }
+                self.textures.push(Texture::checkerboard(c));
+                return Ok(self.textures.len() as u32 - 1);
+            }
+        };
         if let Some(&id) = self.texture_ids.get(path) {
             return Ok(id);
         }
@@ -180,14 +198,18 @@ impl Builder<'_> {
     pub(super) fn attach_albedo_map(
         &mut self,
         id: u32,
-        path: &Path,
+        source: Source,
         keys: [&str; 3],
     ) -> Result<Option<String>, String> {
         let [kd, map, ks] = keys;
         let Some(m) = self.materials.get(id as usize).cloned() else {
             return Err(format!("internal error: material id {id}"));
         };
-        let texture = self.texture(path)?;
+        let what = match source {
+            Source::File(p) => p.display().to_string(),
+            Source::Checker(_) => "a checkerboard".to_string(),
+        };
+        let texture = self.texture(source)?;
         let t_max = self
             .textures
             .get(texture as usize)
@@ -242,7 +264,7 @@ impl Builder<'_> {
                 return Ok(Some(format!(
                     "{map} ({}): only diffuse and glossy (illum 0-2) materials are textured; \
                      this one is drawn without it",
-                    path.display()
+                    what
                 )));
             }
         };
@@ -298,19 +320,40 @@ impl Builder<'_> {
             else {
                 continue;
             };
-            let image = self.dir.join(t);
             let id = self.by_name.get(name).copied().unwrap_or(u32::MAX);
-            let warned = self.attach_albedo_map(id, &image, FILE_KEYS).map_err(|p| {
-                self.err(format!(
-                    "material `{name}`: texture `{t}` ({}): {p}",
-                    image.display()
-                ))
-            })?;
+            let warned = match t {
+                TextureDesc::File(t) => {
+                    let image = self.dir.join(t);
+                    self.attach_albedo_map(id, Source::File(&image), FILE_KEYS)
+                        .map_err(|p| {
+                            self.err(format!(
+                                "material `{name}`: texture `{t}` ({}): {p}",
+                                image.display()
+                            ))
+                        })?
+                }
+                TextureDesc::Checkerboard(c) => {
+                    let c = Checkerboard {
+                        color0: c.color0.into(),
+                        color1: c.color1.into(),
+                        to_uv: c.to_uv,
+                    };
+                    self.attach_albedo_map(id, Source::Checker(c), FILE_KEYS)
+                        .map_err(|p| self.err(format!("material `{name}`: texture: {p}")))?
+                }
+            };
             let at = |w: String| format!("{}: material `{name}`: {w}", self.scene_path.display());
             self.warnings.extend(warned.map(at));
         }
         Ok(())
     }
+}
+
+/// Where a texture comes from.
+#[derive(Clone, Copy)]
+pub(super) enum Source<'p> {
+    File(&'p Path),
+    Checker(Checkerboard),
 }
 
 pub(super) fn in_unit(v: Vec3) -> bool {

@@ -3,7 +3,7 @@
 //! texture coordinates kept, every problem named with its file and line.
 
 use super::Builder;
-use super::materials::MTL_KEYS;
+use super::materials::{MTL_KEYS, Source};
 use super::mtl::{convert_mtl, prescan};
 use super::transform::transform;
 use super::{MAX_COORD, read_regular};
@@ -228,16 +228,18 @@ impl Builder<'_> {
                     let id = self.add_material(&m.name, c.material, c.emission);
                     if let Some(t) = &c.albedo_map {
                         let image = mtl.parent().unwrap_or(Path::new("")).join(t);
-                        let warned = self.attach_albedo_map(id, &image, MTL_KEYS).map_err(|p| {
-                            SceneError::new(
-                                &mtl,
-                                format!(
-                                    "material `{}`: `map_Kd {t}`: {}: {p}",
-                                    m.name,
-                                    image.display()
-                                ),
-                            )
-                        })?;
+                        let warned = self
+                            .attach_albedo_map(id, Source::File(&image), MTL_KEYS)
+                            .map_err(|p| {
+                                SceneError::new(
+                                    &mtl,
+                                    format!(
+                                        "material `{}`: `map_Kd {t}`: {}: {p}",
+                                        m.name,
+                                        image.display()
+                                    ),
+                                )
+                            })?;
                         self.warnings.extend(warned.map(at));
                     }
                     id

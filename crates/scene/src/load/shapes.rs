@@ -66,41 +66,67 @@ pub(super) fn flip(part: &mut TriMesh) {
     }
 }
 
-/// The shape in its own space: flat-shaded triangles wound towards the front.
+/// Mitsuba 3's `cube` mesh (its vertex positions, texture coordinates and faces, as
+/// `mi.traverse` lists them): 24 vertices, 4 per face, two triangles each.
+const CUBE_POSITIONS: [[f32; 3]; 24] = [
+    [1., -1., -1.],
+    [1., -1., 1.],
+    [-1., -1., 1.],
+    [-1., -1., -1.],
+    [1., 1., -1.],
+    [-1., 1., -1.],
+    [-1., 1., 1.],
+    [1., 1., 1.],
+    [1., -1., -1.],
+    [1., 1., -1.],
+    [1., 1., 1.],
+    [1., -1., 1.],
+    [1., -1., 1.],
+    [1., 1., 1.],
+    [-1., 1., 1.],
+    [-1., -1., 1.],
+    [-1., -1., 1.],
+    [-1., 1., 1.],
+    [-1., 1., -1.],
+    [-1., -1., -1.],
+    [1., 1., -1.],
+    [1., -1., -1.],
+    [-1., -1., -1.],
+    [-1., 1., -1.],
+];
+/// Per face, Mitsuba's texture coordinates of its four vertices (the same on every face).
+const CUBE_FACE_UV: [[f32; 2]; 4] = [[0., 1.], [1., 1.], [1., 0.], [0., 0.]];
+/// Per face, its two triangles over its four vertices.
+const CUBE_FACE_TRIANGLES: [[u32; 3]; 2] = [[0, 1, 2], [3, 0, 2]];
+
+/// Mitsuba's texture coordinate `uv` as photonflow stores it. Mitsuba reads a `bitmap` with
+/// `v = 0` at the image's top row, and flips an OBJ's `vt` at load to match; photonflow keeps
+/// OBJ `vt` as written and reads `v = 0` at the bottom row, so a generated shape stores
+/// `1 - v` and both read the same texel.
+fn from_mitsuba(uv: [f32; 2]) -> Vec2 {
+    Vec2::new(uv[0], 1.0 - uv[1])
+}
+
+/// The shape in its own space: flat-shaded triangles wound towards the front, with texture
+/// coordinates as Mitsuba 3 gives them (but the disk's).
 fn local(kind: ShapeKind) -> TriMesh {
     let mut m = TriMesh::default();
-    let quad = |m: &mut TriMesh, corners: [DVec3; 4]| {
-        let base = m.positions.len() as u32;
-        for (c, uv) in corners.iter().zip([[0., 0.], [1., 0.], [1., 1.], [0., 1.]]) {
-            m.positions.push(c.as_vec3());
-            m.texcoords.push(Vec2::from(uv));
-        }
-        m.indices.push([base, base + 1, base + 2]);
-        m.indices.push([base, base + 2, base + 3]);
-    };
     match kind {
-        ShapeKind::Rectangle => quad(
-            &mut m,
-            [
-                DVec3::new(-1., -1., 0.),
-                DVec3::new(1., -1., 0.),
-                DVec3::new(1., 1., 0.),
-                DVec3::new(-1., 1., 0.),
-            ],
-        ),
+        ShapeKind::Rectangle => {
+            // Mitsuba's `rectangle`: uv = (x + 1, y + 1) / 2.
+            for (x, y) in [(-1., -1.), (1., -1.), (1., 1.), (-1., 1.)] {
+                m.positions.push(Vec3::new(x, y, 0.0));
+                m.texcoords
+                    .push(from_mitsuba([(x + 1.) / 2., (y + 1.) / 2.]));
+            }
+            m.indices = vec![[0, 1, 2], [0, 2, 3]];
+        }
         ShapeKind::Cube => {
-            // Each face: its outward normal n and two axes u, v with u x v = n.
-            for n in [
-                DVec3::X,
-                DVec3::Y,
-                DVec3::Z,
-                -DVec3::X,
-                -DVec3::Y,
-                -DVec3::Z,
-            ] {
-                let u = if n.x != 0.0 { DVec3::Y } else { DVec3::X };
-                let v = n.cross(u);
-                quad(&mut m, [n - u - v, n + u - v, n + u + v, n - u + v]);
+            m.positions = CUBE_POSITIONS.iter().map(|&p| Vec3::from(p)).collect();
+            for face in 0..6u32 {
+                m.texcoords.extend(CUBE_FACE_UV.map(from_mitsuba));
+                m.indices
+                    .extend(CUBE_FACE_TRIANGLES.map(|t| t.map(|i| 4 * face + i)));
             }
         }
         ShapeKind::Disk => {

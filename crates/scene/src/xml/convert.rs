@@ -6,8 +6,8 @@ use super::props::{Color, Ids, Plugin};
 use super::tree::Elem;
 use crate::error::SceneError;
 use crate::file::{
-    CameraDesc, LightDesc, MaterialDesc, MeshDesc, NormalMode, SamplerKind, SceneFile, ShapeKind,
-    SphereDesc,
+    CameraDesc, CheckerboardDesc, CheckerboardKind, LightDesc, MaterialDesc, MeshDesc, NormalMode,
+    SamplerKind, SceneFile, ShapeKind, SphereDesc, TextureDesc,
 };
 use glam::{DMat3, DMat4, DVec3};
 use std::collections::{BTreeMap, HashMap};
@@ -457,7 +457,7 @@ impl<'a> Converter<'a> {
                     Some(Color::Texture(t)) => MaterialDesc::Lambertian {
                         albedo: [1.0; 3],
                         emission: [0.0; 3],
-                        texture: Some(self.bitmap(t)?),
+                        texture: Some(self.texture(t)?),
                     },
                 }
             }
@@ -542,37 +542,55 @@ impl<'a> Converter<'a> {
         Ok(a as f32)
     }
 
-    /// A `bitmap` texture as the file name a scene-file material reads.
-    fn bitmap(&mut self, t: &'a Elem) -> Result<String, SceneError> {
+    /// A `bitmap` (as its file's name) or `checkerboard` texture, as a scene-file material
+    /// reads it.
+    fn texture(&mut self, t: &'a Elem) -> Result<TextureDesc, SceneError> {
         let p = Plugin::new(t, self.ids)?;
-        if p.kind != "bitmap" {
-            return Err(p.err("photonflow reads `bitmap` textures"));
-        }
-        let f = p
-            .string("filename")?
-            .ok_or_else(|| p.err("needs `filename`"))?;
-        if p.boolean("raw")? == Some(true) {
-            return Err(
-                p.err("raw true: photonflow decodes 8- and 16-bit images as sRGB (EXR as linear)")
-            );
-        }
-        match p.string("filter_type")? {
-            None | Some("bilinear") => {}
-            Some(other) => {
-                return Err(p.err(format_args!(
-                    "filter_type `{other}`: photonflow reads bilinear"
-                )));
+        let desc = match p.kind {
+            "bitmap" => {
+                let f = p
+                    .string("filename")?
+                    .ok_or_else(|| p.err("needs `filename`"))?;
+                if p.boolean("raw")? == Some(true) {
+                    return Err(p.err(
+                        "raw true: photonflow decodes 8- and 16-bit images as sRGB (EXR as \
+                         linear)",
+                    ));
+                }
+                match p.string("filter_type")? {
+                    None | Some("bilinear") => {}
+                    Some(other) => {
+                        return Err(p.err(format_args!(
+                            "filter_type `{other}`: photonflow reads bilinear"
+                        )));
+                    }
+                }
+                match p.string("wrap_mode")? {
+                    None | Some("repeat") => {}
+                    Some(other) => {
+                        return Err(p.err(format_args!("wrap_mode `{other}`: photonflow repeats")));
+                    }
+                }
+                if p.transform("to_uv")?.is_some() {
+                    return Err(p.err("a bitmap's to_uv: not read by photonflow"));
+                }
+                TextureDesc::File(self.path_of(t, f))
             }
-        }
-        match p.string("wrap_mode")? {
-            None | Some("repeat") => {}
-            Some(other) => {
-                return Err(p.err(format_args!("wrap_mode `{other}`: photonflow repeats")));
+            "checkerboard" => {
+                let m = p.transform("to_uv")?.unwrap_or(DMat4::IDENTITY);
+                // Mitsuba's `to_uv` is a 3 x 3 matrix on (u, v, 1): its first two rows.
+                let row = |r: usize| [m.col(0)[r] as f32, m.col(1)[r] as f32, m.col(3)[r] as f32];
+                TextureDesc::Checkerboard(CheckerboardDesc {
+                    kind: CheckerboardKind::Checkerboard,
+                    color0: p.rgb("color0", [0.4; 3])?,
+                    color1: p.rgb("color1", [0.2; 3])?,
+                    to_uv: [row(0), row(1)],
+                })
             }
-        }
-        let path = self.path_of(t, f);
+            _ => return Err(p.err("photonflow reads `bitmap` and `checkerboard` textures")),
+        };
         p.finish(&mut self.warnings);
-        Ok(path)
+        Ok(desc)
     }
 
     fn emitter(&mut self, e: &'a Elem) -> Result<(), SceneError> {
@@ -662,8 +680,8 @@ impl<'a> Converter<'a> {
 /// `int_ior / ext_ior`, each a number or one of Mitsuba 3's named materials.
 fn ior(p: &Plugin) -> Result<f32, SceneError> {
     let side = |key: &str, default: f64| -> Result<f64, SceneError> {
-        if let Some(v) = p.float(key)? {
-            return Ok(v);
+        if p.tag_of(key) != Some("string") {
+            return Ok(p.float(key)?.unwrap_or(default));
         }
         match p.string(key)? {
             None => Ok(default),

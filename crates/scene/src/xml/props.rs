@@ -72,6 +72,15 @@ impl<'a> Plugin<'a> {
         Some(c)
     }
 
+    /// The tag of the value child named `name` (`float`, `string`, ...), not marking it read.
+    pub fn tag_of(&self, name: &str) -> Option<&'a str> {
+        self.e
+            .children
+            .iter()
+            .find(|c| VALUE_TAGS.contains(&c.tag.as_str()) && c.attr("name") == Some(name))
+            .map(|c| c.tag.as_str())
+    }
+
     /// Marks a parameter read without reading it (one whose every value draws the same).
     pub fn ignore(&self, name: &str) {
         let _ = self.value(name);
