@@ -239,6 +239,26 @@ pub(crate) fn first_diffuse(
         };
         let frame = Frame::from_z(hit.ns);
         let wo_l = frame.to_local(wo);
+        // Light from a point, spot or directional light reflected by this glossy lobe: no
+        // bounce the walk samples can reach a delta light, and neither next-event estimation
+        // at a diffuse vertex nor a photon map holds `L G` seen from here, so it is counted
+        // here, each delta light with its one sample (no random numbers: the walk's layout
+        // stays), on the same terms as emission past a glossy bounce.
+        if lights.has_delta() && !bsdf.is_delta() {
+            for ls in lights.delta_samples(hit.point.p) {
+                let wi_l = frame.to_local(ls.wi);
+                let f = bsdf.f(wo_l, wi_l, TransportMode::Radiance);
+                if f == Vec3::ZERO
+                    || !sides_agree(wo, ls.wi, hit.point.n, wo_l, wi_l)
+                    || scene
+                        .geometry
+                        .occluded(&hit.point.spawn_ray_to_point(&ls.point))
+                {
+                    continue;
+                }
+                emitted += b.beta * lobe * f * wi_l.z.abs() * ls.le / ls.pdf;
+            }
+        }
         let split = bsdf.glass_eta().is_some() && b.splits < splits;
         let samples = if split {
             // Both branches, weighted by what each carries (f |cos|, no pdf); the stack is

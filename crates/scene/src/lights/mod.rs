@@ -434,6 +434,8 @@ pub struct LightTable {
     /// Light index of each mesh triangle, or `NOT_A_LIGHT`.
     light_of_triangle: Vec<u32>,
     total: DVec3,
+    /// Indices of the point, spot and directional lights.
+    delta: Vec<usize>,
 }
 
 impl LightTable {
@@ -484,7 +486,7 @@ impl LightTable {
             *light_of_triangle.get_mut(l.triangle as usize)? = i as u32;
         }
         let total = power.iter().fold(DVec3::ZERO, |s, p| s + *p);
-        let entries = lights
+        let entries: Vec<Entry> = lights
             .into_iter()
             .zip(&power)
             .zip(&weights)
@@ -494,6 +496,9 @@ impl LightTable {
                 pmf: w / sum,
             })
             .collect();
+        let delta = (0..entries.len())
+            .filter(|&i| entries.get(i).is_some_and(|e| e.light.is_delta()))
+            .collect();
         Some(LightTable {
             distribution: Distribution1D::new(&weights),
             entries,
@@ -501,6 +506,7 @@ impl LightTable {
             sphere,
             light_of_triangle,
             total,
+            delta,
         })
     }
 
@@ -622,6 +628,33 @@ impl LightTable {
             pdf,
             delta: e.light.is_delta(),
         })
+    }
+
+    /// Whether the scene has a point, spot or directional light.
+    pub fn has_delta(&self) -> bool {
+        !self.delta.is_empty()
+    }
+
+    /// Each delta light (point, spot, directional) as seen from `from`, chosen with
+    /// probability 1: a delta light has one sample, so a sum over them needs no random
+    /// numbers. Occlusion is the caller's to test.
+    pub fn delta_samples(&self, from: Vec3) -> impl Iterator<Item = LightSample> + '_ {
+        self.delta
+            .iter()
+            .filter_map(|&i| Some((i, self.entries.get(i)?)))
+            .filter_map(move |(i, e)| {
+                let (point, le, wi, dist, pdf) =
+                    e.light.sample_li(1.0, from, [0.5, 0.5], &self.sphere)?;
+                Some(LightSample {
+                    light: i,
+                    point,
+                    le,
+                    wi,
+                    dist,
+                    pdf,
+                    delta: true,
+                })
+            })
     }
 
     /// Solid-angle density with which [`LightTable::sample`] from `from` produces the point
