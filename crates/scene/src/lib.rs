@@ -33,7 +33,7 @@ pub use envmap::EnvMap;
 pub use error::SceneError;
 pub use file::{
     CameraDesc, EmissionSource, LightDesc, MaterialDesc, MeshDesc, Method, NormalMode,
-    RenderSettings, SamplerKind, SceneFile, SphereDesc,
+    RenderSettings, SamplerKind, SceneFile, SphereDesc, TfReading,
 };
 pub use lights::{
     AreaLight, Directional, EmitPdfs, Emitted, Environment, Light, LightSample, LightTable,
