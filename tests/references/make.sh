@@ -12,10 +12,12 @@
 #             and draws different random numbers, so its images differ within noise
 # NAME        cornell-spheres-analytic, cornell-spheres-closeup, cornell-glossy, cornell-rough,
 #             cornell-textured, cornell-coloured-glass, furnace, plane-light, corner,
-#             point-caustic, cornell-spot, environment, mcguire-original, mitsuba-worksheet,
+#             point-caustic, cornell-spot, environment, mcguire-original, mcguire-sphere,
+#             mcguire-mirror, mcguire-water, mcguire-glossy, mitsuba-worksheet,
 #             mitsuba-shapes-and-lights (default: all)
 # SPP_POINT, SPP_SPOT, SPP_ENV  spp per half of point-caustic, cornell-spot, environment
 #             (default 24576, 8192, 24576)
+# SPP_MCGUIRE spp per half of mcguire-sphere, -mirror, -water and -glossy (default 8192)
 # BENCH=1     the benchmark references instead of the test ones, for the NAMEs that have
 #             them: mcguire-original at 256 x 256 (8192 spp per half) and
 #             cornell-spheres-analytic at 512 x 512 (4096 spp per half); needs OUTDIR (they
@@ -67,12 +69,15 @@ render() {
   local name=$1 kind=$2 toml=$3 w=$4 h=$5 spp=$6 pp=$7 obj=$8
   shift 8
   camera "$kind" "$toml" "$w" "$h" "$TMP/$name-${w}x$h.json"
-  local half seed lights=() integrator=${INTEGRATOR:-path}
+  local half seed lights=() integrator=${INTEGRATOR:-path} tf
   [ ! -e "$TMP/$name-${w}x$h-lights.json" ] || lights=(--lights "$TMP/$name-${w}x$h-lights.json")
+  # How the MTL's `Tf` is read on glass: the scene file's `[[mesh]] tf` (peer_scene.py checks
+  # there is one mesh), given to the wrapper as photonflow reads it.
+  tf=$("$PY" -c 'import sys, tomllib; print(tomllib.load(open(sys.argv[1], "rb"))["mesh"][0].get("tf", "transmitted"))' "$toml")
   for half in ${HALVES:-a b}; do
     if [ $half = a ]; then seed=$SEED_A; else seed=$SEED_B; fi
     echo "== $name ${w}x$h half $half: seed $seed, $spp spp, $integrator"
-    "$PY" "$HERE/mitsuba_render_rough.py" "$PEERS" "$obj" "$@" ${lights[@]+"${lights[@]}"} \
+    "$PY" "$HERE/mitsuba_render_rough.py" "$PEERS" "$obj" "$@" ${lights[@]+"${lights[@]}"} --tf "$tf" \
       --camera "$TMP/$name-${w}x$h.json" \
       --width "$w" --height "$h" --spp "$spp" --spp-per-pass "$pp" --seed "$seed" \
       --integrator "$integrator" --max-depth -1 --rr-depth 5 --sampler independent --rfilter box \
@@ -132,10 +137,11 @@ render_xml() {
 SPP_POINT=${SPP_POINT:-24576}
 SPP_SPOT=${SPP_SPOT:-8192}
 SPP_ENV=${SPP_ENV:-24576}
+SPP_MCGUIRE=${SPP_MCGUIRE:-8192}
 P=$PEERS/worksheet
 S=$REPO/scenes
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough cornell-textured cornell-coloured-glass furnace plane-light corner point-caustic cornell-spot environment mcguire-original mitsuba-worksheet mitsuba-shapes-and-lights)
+[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough cornell-textured cornell-coloured-glass furnace plane-light corner point-caustic cornell-spot environment mcguire-original mcguire-sphere mcguire-mirror mcguire-water mcguire-glossy mitsuba-worksheet mitsuba-shapes-and-lights)
 if [ "$BENCH" = 1 ]; then
   for n in "${names[@]}"; do
     case $n in
@@ -160,6 +166,18 @@ for n in "${names[@]}"; do
       # McGuire's OBJ and MTL as they are: illum 2 with Ks 0 everywhere (Lambertian Kd), so
       # no --glossy; the light's Ke an area emitter on its Kd.
       render $n obj "$S/mcguire/original.toml" 128 128 8192 1024 "$S/mcguire/CornellBox-Original.obj" ;;
+    mcguire-sphere)
+      # Mirror ball (illum 5: conductor, Ks), glass ball (illum 4: dielectric, Ni, 1 - Tf by
+      # the scene file's tf = "absorbed"), diffuse walls.
+      render $n obj "$S/mcguire/sphere.toml" 128 128 $SPP_MCGUIRE 1024 "$S/mcguire/CornellBox-Sphere.obj" ;;
+    mcguire-mirror)
+      render $n obj "$S/mcguire/mirror.toml" 128 128 $SPP_MCGUIRE 1024 "$S/mcguire/CornellBox-Mirror.obj" ;;
+    mcguire-water)
+      # The water (illum 7, Ni 1.33) and the glass ball as in mcguire-sphere (tf = "absorbed").
+      render $n obj "$S/mcguire/water.toml" 128 128 $SPP_MCGUIRE 1024 "$S/mcguire/CornellBox-Water.obj" ;;
+    mcguire-glossy)
+      # The glossy sphere and block are illum 2 with Ks > 0: the peers' --glossy mapping.
+      render $n obj "$S/mcguire/glossy.toml" 128 128 $SPP_MCGUIRE 1024 "$S/mcguire/CornellBox-Glossy.obj" --glossy ;;
     cornell-glossy)
       # The floor is MTL illum 2: the peers' --glossy mapping (Lambertian Kd + GGX Ks).
       render $n obj-spheres "$S/cornell-glossy/glossy-floor.toml" 128 128 8192 1024 \

@@ -8,6 +8,12 @@ albedo textures:
   material, Kd 1 1 1           sRGB-decoded); the OBJ's `vt` become the mesh's texture
                                coordinates as Mitsuba's own OBJ reader makes them, (u, 1 - v)
 
+`--tf transmitted|absorbed` (default transmitted) says how the MTL's `Tf` is read on glass
+(illum 4, 6, 7, 9), as the scene file's `[[mesh]] tf` says to photonflow: `transmitted`, the
+Wavefront spec's fraction let through, is Mitsuba's `specular_transmittance` as it is;
+`absorbed` (G3D's reading, McGuire's archive) gives it `1 - Tf`. Unlike the peers' mapping,
+which drops it when a channel is 1, it is set whenever a channel is below 1.
+
 It also takes `--lights FILE.json`: a JSON list of the scene file's `[[light]]` tables (as
 make.sh writes them, `filename` made absolute), added to the scene as Mitsuba 3 emitters:
 
@@ -35,6 +41,13 @@ if "--lights" in sys.argv:
     i = sys.argv.index("--lights")
     lights_json = sys.argv[i + 1]
     del sys.argv[i:i + 2]
+tf_reading = "transmitted"
+if "--tf" in sys.argv:
+    i = sys.argv.index("--tf")
+    tf_reading = sys.argv[i + 1]
+    del sys.argv[i:i + 2]
+    if tf_reading not in ("transmitted", "absorbed"):
+        sys.exit(f"--tf {tf_reading}: transmitted or absorbed")
 sys.path.insert(0, peers)
 import mitsuba_render  # noqa: E402
 import objmtl  # noqa: E402
@@ -52,7 +65,14 @@ def rough_classify(mat, glossy=False):
         return "roughconductor", {"reflectance": tuple(mat["Ks"]), "alpha": float(mat["Ns"])}
     if illum == 14:
         return "roughdielectric", {"ior": float(mat["Ni"]), "alpha": float(mat["Ns"])}
-    return classify(mat, glossy)
+    kind, p = classify(mat, glossy)
+    if kind == "dielectric":
+        tf = tuple(float(x) for x in mat.get("Tf", (1.0, 1.0, 1.0)))
+        if min(tf) < 0.0 or max(tf) > 1.0:
+            sys.exit(f"Tf {tf}: each channel in [0, 1]")
+        t = tf if tf_reading == "transmitted" else tuple(1.0 - x for x in tf)
+        return "glass", {"ior": p["ior"], "transmittance": t}
+    return kind, p
 
 
 def rough_bsdf_dict(kind, p):
@@ -62,6 +82,11 @@ def rough_bsdf_dict(kind, p):
     if kind == "texture":
         return {"type": "diffuse", "reflectance": {"type": "bitmap", "filename": p["filename"],
                 "filter_type": "bilinear", "wrap_mode": "repeat", "raw": False}}
+    if kind == "glass":
+        d = {"type": "dielectric", "int_ior": float(p["ior"]), "ext_ior": 1.0}
+        if min(p["transmittance"]) < 1.0:
+            d["specular_transmittance"] = mitsuba_render.rgb(p["transmittance"])
+        return d
     if kind == "roughdielectric":
         return {"type": "roughdielectric", "distribution": "ggx", "alpha": p["alpha"],
                 "int_ior": p["ior"], "ext_ior": 1.0}

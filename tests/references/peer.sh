@@ -48,13 +48,14 @@ TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 cannot() { echo "$peer: $*" >&2; exit 3; }
 
-# KIND W H OBJ SPHERES LIGHTS GLOSSY WORKSHEET DIAG, and the camera JSON.
+# KIND W H OBJ SPHERES LIGHTS GLOSSY WORKSHEET TF DIAG, and the camera JSON.
 eval "$("$PY" "$HERE/peer_scene.py" "$PEERS" auto "$scene" "$TMP/camera.json")"
 spheres=()
 [ -z "$SPHERES" ] || spheres=(--spheres "$SPHERES")
 only_mtl() { # the peers other than Mitsuba map only the MTL's diffuse, mirror, glass, Ke
   [ -z "$LIGHTS" ] || cannot "the scene's [[light]] tables: only mitsuba maps them"
   [ "$GLOSSY" = 0 ] || cannot "glossy MTL materials (illum 2, Ks > 0): only mitsuba maps them"
+  [ "$TF" = transmitted ] || cannot "tf = \"$TF\" (the MTL's Tf read as absorbed): only mitsuba reads it so"
 }
 
 case $peer in
@@ -67,7 +68,7 @@ case $peer in
     [ "$GLOSSY" = 0 ] || glossy=(--glossy)
     mi() { # SPP OUT
       "$PY" "$HERE/mitsuba_render_rough.py" "$PEERS" "$OBJ" ${spheres[@]+"${spheres[@]}"} \
-        ${lights[@]+"${lights[@]}"} ${glossy[@]+"${glossy[@]}"} --camera "$TMP/camera.json" \
+        ${lights[@]+"${lights[@]}"} ${glossy[@]+"${glossy[@]}"} --tf "$TF" --camera "$TMP/camera.json" \
         --width "$W" --height "$H" --spp "$1" --spp-per-pass 16 --seed 7 --integrator "$integrator" \
         --max-depth -1 --rr-depth 5 --sampler independent --rfilter box --variant llvm_ad_rgb \
         -o "$2" > /dev/null

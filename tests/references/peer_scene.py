@@ -10,7 +10,8 @@
       assignments on stdout for peer.sh: KIND, W, H, OBJ (the OBJ the peers read), SPHERES
       (their spheres JSON, or empty), LIGHTS (the lights JSON, or empty), GLOSSY (1 when an
       MTL material is illum 2 with Ks > 0: only Mitsuba's --glossy maps it) and WORKSHEET (1
-      for the worksheet scene itself, the one SmallVCM renders: its camera, clear glass) and
+      for the worksheet scene itself, the one SmallVCM renders: its camera, clear glass), TF
+      (the mesh's `tf`: how its MTL's `Tf` is read on glass, `transmitted` or `absorbed`) and
       DIAG (the diagonal of the OBJ's bounding box, for radii in scene units).
 """
 import json, os, shlex, sys, tomllib
@@ -157,7 +158,7 @@ def auto(peers, src, out):
     diag = sum((max(v[i] for v in vs) - min(v[i] for v in vs)) ** 2 for i in range(3)) ** 0.5
     for k, v in [("DIAG", f"{diag:.6g}"), ("KIND", kind), ("W", w), ("H", h), ("OBJ", obj), ("SPHERES", sph),
                  ("LIGHTS", lights if os.path.exists(lights) else ""), ("GLOSSY", glossy),
-                 ("WORKSHEET", worksheet)]:
+                 ("WORKSHEET", worksheet), ("TF", m.get("tf", "transmitted"))]:
         print(f"{k}={shlex.quote(str(v))}")
 
 

@@ -225,6 +225,25 @@ pub enum EmissionSource {
     Ka,
 }
 
+/// How an OBJ mesh's MTL files mean `Tf` on glass (illum 4, 6, 7, 9): what each crossing of
+/// the surface keeps is `Tf` or `1 - Tf`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum TfReading {
+    /// `Tf` is the fraction transmitted (the Wavefront MTL spec's transmission filter).
+    #[default]
+    Transmitted,
+    /// `Tf` is the fraction taken away: the glass keeps `1 - Tf`, as G3D reads it (Morgan
+    /// McGuire's renderer; the Cornell boxes of his Computer Graphics Archive are written so).
+    Absorbed,
+}
+
+impl TfReading {
+    fn is_default(&self) -> bool {
+        *self == TfReading::default()
+    }
+}
+
 /// How vertex normals are obtained.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
@@ -289,6 +308,10 @@ pub struct MeshDesc {
     pub emission: EmissionSource,
     #[serde(default)]
     pub normals: NormalMode,
+    /// How the MTL's `Tf` is read on glass (default: the fraction transmitted). Left out of
+    /// the serialized file when default, so scenes without it keep their hashes.
+    #[serde(default, skip_serializing_if = "TfReading::is_default")]
+    pub tf: TfReading,
 }
 
 /// Shapes a mesh can be generated as, each in its own space as Mitsuba 3 defines it.

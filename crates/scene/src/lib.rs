@@ -35,7 +35,7 @@ pub use error::SceneError;
 pub use file::{
     CameraDesc, CheckerboardDesc, CheckerboardKind, EmissionSource, LightDesc, MaterialDesc,
     MeshDesc, Method, NormalMode, RenderSettings, SamplerKind, SceneFile, ShapeKind, SphereDesc,
-    TextureDesc,
+    TextureDesc, TfReading,
 };
 pub use lights::{
     AreaLight, Directional, EmitPdfs, Emitted, Environment, Light, LightSample, LightTable,

@@ -20,14 +20,14 @@
 //! | `Ka` | emitted radiance with `[[mesh]] emission = "ka"` (the course's convention; a material with `Ke` too is refused); otherwise the ambient colour, which a physically based renderer does not use |
 //! | `Ni` | the index of refraction of glass; not read elsewhere |
 //! | `Ks` | the specular colour of illum 2, 3, 5, 8 and 11 (above; elsewhere: warning); negative or NaN in a channel, refused whatever the `illum` |
-//! | `Tf` | on glass, its transmittance: a factor on refracted light at every crossing, each channel in [0, 1] (refused outside it); warning elsewhere. Absorption inside glass has no MTL key: use the scene file's `absorption` |
+//! | `Tf` | on glass, its transmittance: a factor on refracted light at every crossing, each channel in [0, 1] (refused outside it); warning elsewhere. With `[[mesh]] tf = "absorbed"` the glass keeps `1 - Tf` instead: G3D's reading, in which Morgan McGuire's Cornell boxes are written (their `Tf 0.1` is clear glass). Glass that would keep less than half the light at a crossing in every channel is drawn so with a warning naming the other reading. Absent, clear glass either way. Absorption inside glass has no MTL key: use the scene file's `absorption` |
 //! | `map_Kd` | the diffuse albedo's texture, times `Kd` (the MTL spec's product; the texture alone where `Kd` is absent): PNG, JPEG, TGA or EXR, relative to the MTL file; 8-bit and 16-bit images are sRGB-decoded, EXR is linear; read at the OBJ's `vt` (without them, at each triangle's barycentrics: warning), bilinear, repeated. On illum 0-2 only (elsewhere: warning, drawn without). Where `Kd` x the brightest texel (+ `Ks` on illum 2) exceeds 1 in a channel, they are scaled there to 1 (warning). A missing or unreadable image, or texture options (`-s`, `-o`, ...), are refused |
 //! | `map_Ks`, `map_d` | refused (of the texture maps only `map_Kd` is rendered) |
 //! | `bump`, `map_Bump`, `map_Ns`, `refl`, `disp`, `decal` | warning: drawn without |
 //! | `Pr`, `Pm`, `Ps`, `Pc`, `Pcr`, `aniso`, `anisor`, `map_Pr`, `map_Pm` (the PBR extension) | refused |
 
 use super::materials::{check, in_unit};
-use crate::file::EmissionSource;
+use crate::file::{EmissionSource, TfReading};
 use crate::material::ALPHA_RANGE;
 use crate::material::Material;
 use glam::Vec3;
@@ -271,6 +271,7 @@ fn read_keys(m: &tobj::Material, emission: EmissionSource) -> Result<Keys, Strin
 pub(super) fn convert_mtl(
     m: &tobj::Material,
     emission: EmissionSource,
+    tf_reading: TfReading,
 ) -> Result<Converted, String> {
     let Keys {
         kd,
@@ -308,6 +309,28 @@ pub(super) fn convert_mtl(
     if glassy && tf.is_some_and(|t| !in_unit(t)) {
         return Err(format!(
             "`Tf {tf_text}`: the transmission filter of glass must lie in [0, 1] in each channel"
+        ));
+    }
+    // What glass keeps at a crossing: `Tf` as the spec reads it, or `1 - Tf` (G3D's reading).
+    let tf = match tf_reading {
+        TfReading::Transmitted => tf,
+        TfReading::Absorbed if glassy => tf.map(|t| Vec3::ONE - t),
+        TfReading::Absorbed => tf,
+    };
+    if glassy && let Some(t) = tf.filter(|t| t.max_element() < 0.5) {
+        let (now, other) = match tf_reading {
+            TfReading::Transmitted => ("the fraction transmitted", "absorbed"),
+            TfReading::Absorbed => ("the fraction absorbed (`tf = \"absorbed\"`)", "transmitted"),
+        };
+        warnings.push(format!(
+            "`Tf {}` read as {now}: the glass keeps ({}, {}, {}) of the light at each \
+             crossing and absorbs most of it (a ball, crossed twice, keeps under a quarter); \
+             if the file means the other reading (G3D's, in which Morgan McGuire's archive is \
+             written, takes `Tf` as the fraction absorbed), set `[[mesh]] tf = \"{other}\"`",
+            tf_text.trim(),
+            t.x,
+            t.y,
+            t.z
         ));
     }
     if !glassy && tf.is_some_and(|t| t != Vec3::ONE) {

@@ -8,7 +8,7 @@ use super::mtl::{convert_mtl, prescan};
 use super::transform::transform;
 use super::{MAX_COORD, read_regular};
 use crate::error::SceneError;
-use crate::file::{EmissionSource, MeshDesc, NormalMode};
+use crate::file::{EmissionSource, MeshDesc, NormalMode, TfReading};
 use geom::{TriMesh, smooth_vertex_normals};
 use glam::{DMat3, DMat4, DVec3, Vec2};
 use std::cell::RefCell;
@@ -72,7 +72,7 @@ impl Builder<'_> {
         let oerr = |problem: String| SceneError::new(&obj_path, format!("{problem} ({of})"));
         // A mesh given its own material reads no MTL file: every face is that material.
         let parsed = self.parse_obj(index, &obj_path, &of, own.is_none(), &oerr)?;
-        let mat_ids = self.mtl_materials(&parsed, &obj_path, desc.emission)?;
+        let mat_ids = self.mtl_materials(&parsed, &obj_path, desc.emission, desc.tf)?;
         self.validate_materials().map_err(|e| oerr(e.problem))?;
         check_faces(&parsed, own.is_none(), &oerr)?;
         let faces = match own {
@@ -190,6 +190,7 @@ impl Builder<'_> {
         parsed: &Parsed,
         obj_path: &Path,
         emission: EmissionSource,
+        tf: TfReading,
     ) -> Result<Vec<u32>, SceneError> {
         let mats = &parsed.materials;
         // tobj's `usemtl` reads the last of several definitions of one name, as other loaders
@@ -221,7 +222,7 @@ impl Builder<'_> {
                              loaders do"
                         )));
                     }
-                    let c = convert_mtl(m, emission).map_err(|p| {
+                    let c = convert_mtl(m, emission, tf).map_err(|p| {
                         SceneError::new(&mtl, format!("material `{}`: {p}", m.name))
                     })?;
                     self.warnings.extend(c.warnings.into_iter().map(at));

@@ -53,13 +53,18 @@ fn one_number_mtl_colour_is_grey() {
 /// The floor's material `white` of [`GOOD_MTL`] given `lines` instead, loaded with emission
 /// from `emission` (`ke`, `ka`): the material, and the warnings.
 fn white_as(lines: &str, emission: &str) -> Result<(Material, Vec<String>), String> {
+    white_with(lines, emission, "")
+}
+
+/// [`white_as`] with `mesh` (TOML lines) added to the scene file's `[[mesh]]` table.
+fn white_with(lines: &str, emission: &str, mesh: &str) -> Result<(Material, Vec<String>), String> {
     let mtl = GOOD_MTL.replace("Kd 0.5 0.5 0.5", lines);
     let mtl = if emission == "ka" {
         mtl.replace("Ke 4 4 4", "Ka 4 4 4")
     } else {
         mtl
     };
-    let toml = format!("{}emission = \"{emission}\"\n", scene_toml("a.obj"));
+    let toml = format!("{}emission = \"{emission}\"\n{mesh}", scene_toml("a.obj"));
     let dir = Scratch::new(
         "mtl-conventions",
         &[("s.toml", &toml), ("a.obj", GOOD_OBJ), ("m.mtl", &mtl)],
@@ -232,7 +237,12 @@ fn mtl_files_follow_the_documented_table() {
         quiet("Ni 1.5\nTf 0.9 0.5 0.5\nillum 7"),
         tinted(1.5, Vec3::new(0.9, 0.5, 0.5))
     );
-    assert_eq!(quiet("Ni 1.5\nTf 0.25\nillum 4"), tinted(1.5, v(0.25)));
+    // Glass keeping under half the light in every channel is drawn so, with a warning naming
+    // the other reading.
+    assert_eq!(
+        warned("Ni 1.5\nTf 0.25\nillum 4", "tf = \"absorbed\""),
+        tinted(1.5, v(0.25))
+    );
     assert_eq!(
         quiet("Kd 0.5 0.5 0.5\nNi 1.4\nd 0.2\nTf 0.2 0.4 0.6"),
         tinted(1.4, Vec3::new(0.2, 0.4, 0.6))
@@ -269,4 +279,51 @@ fn mtl_files_follow_the_documented_table() {
         "ka",
         "`Ke 5 5 5` is not read",
     );
+}
+
+/// `[[mesh]] tf = "absorbed"` (G3D's reading of `Tf`): glass keeps `1 - Tf` at each
+/// crossing; an absent `Tf` is clear glass either way; `Tf` on an opaque surface is warned
+/// about as under the spec's reading; glass that would keep under half the light is drawn so
+/// with a warning naming `tf = "transmitted"`.
+#[test]
+fn tf_absorbed_reads_tf_as_g3d_does() {
+    let absorbed = |lines: &str| {
+        white_with(lines, "ke", "tf = \"absorbed\"\n").unwrap_or_else(|e| panic!("{lines}: {e}"))
+    };
+    let glass = |ior: f32, t: Vec3| Material::Dielectric {
+        ior,
+        transmittance: t,
+        absorption: Vec3::ZERO,
+    };
+    // McGuire's glass ball and water.
+    let (m, w) = absorbed("Kd 0.01 0.01 0.01\nNi 1.5\nTf 0.10 0.10 0.10\nillum 4");
+    assert_eq!(m, glass(1.5, Vec3::splat(0.9)));
+    assert!(!w.iter().any(|w| w.contains("absorbs most")), "{w:?}");
+    let (m, _) = absorbed("Ni 1.33\nTf 0.10 0.10 0.0\nillum 7");
+    assert_eq!(m, glass(1.33, Vec3::new(0.9, 0.9, 1.0)));
+    let (m, w) = absorbed("Ni 1.5\nillum 7");
+    assert_eq!(m, glass(1.5, Vec3::ONE));
+    assert!(w.is_empty(), "{w:?}");
+    let (m, w) = absorbed("Ni 1.5\nTf 0.9 0.8 0.95\nillum 4");
+    assert_eq!(m, glass(1.5, Vec3::ONE - Vec3::new(0.9, 0.8, 0.95)));
+    assert!(
+        w.iter()
+            .any(|w| w.contains("absorbs most") && w.contains("tf = \"transmitted\"")),
+        "{w:?}"
+    );
+    let (m, w) = absorbed("Kd 0.5 0.5 0.5\nTf 0.5 0.5 0.5");
+    assert_eq!(
+        m,
+        Material::Lambertian {
+            albedo: Vec3::splat(0.5)
+        }
+    );
+    assert!(w.iter().any(|w| w.contains("`Tf 0.5 0.5 0.5`")), "{w:?}");
+    // Out of [0, 1] is refused under either reading.
+    let e = white_with(
+        "Ni 1.5\nTf 1.2 0.5 0.5\nillum 7",
+        "ke",
+        "tf = \"absorbed\"\n",
+    );
+    assert!(e.is_err_and(|e| e.contains("`Tf 1.2 0.5 0.5`")));
 }
