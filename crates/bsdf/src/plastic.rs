@@ -83,7 +83,10 @@ impl Plastic {
     /// Probability that [`Plastic::sample`] picks the coating's delta reflection at `wo`.
     #[inline]
     pub fn specular_probability(&self, wo: Vec3) -> f32 {
-        coating_probability(fresnel_dielectric(wo.z.abs(), self.eta), self.specular_weight)
+        coating_probability(
+            fresnel_dielectric(wo.z.abs(), self.eta),
+            self.specular_weight,
+        )
     }
 
     /// The diffuse lobe's `f` (both directions on the upper side).
@@ -120,11 +123,21 @@ impl Plastic {
         let ps = coating_probability(fo, self.specular_weight);
         let (mut wi, f, pdf, flags) = if uc < ps {
             let wi = Vec3::new(-up.x, -up.y, up.z);
-            (wi, self.specular * (fo / wi.z), ps, Flags::SPECULAR_REFLECTION)
+            (
+                wi,
+                self.specular * (fo / wi.z),
+                ps,
+                Flags::SPECULAR_REFLECTION,
+            )
         } else {
             let wi = sample_cosine_hemisphere(u);
             let pdf = (1.0 - ps) * wi.z * FRAC_1_PI;
-            (wi, self.diffuse_f(up.z, wi.z), pdf, Flags::DIFFUSE_REFLECTION)
+            (
+                wi,
+                self.diffuse_f(up.z, wi.z),
+                pdf,
+                Flags::DIFFUSE_REFLECTION,
+            )
         };
         if !(pdf > 0.0 && f.is_finite()) {
             return None;

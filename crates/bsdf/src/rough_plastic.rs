@@ -235,8 +235,11 @@ impl RoughPlastic {
             None => Vec3::ZERO,
         };
         let t = self.table.at(wo.z) * self.table.at(wi.z);
-        let diff = internal_albedo(self.diffuse, self.table.internal_reflectance, self.nonlinear)
-            * (t * FRAC_1_PI / (self.eta * self.eta));
+        let diff = internal_albedo(
+            self.diffuse,
+            self.table.internal_reflectance,
+            self.nonlinear,
+        ) * (t * FRAC_1_PI / (self.eta * self.eta));
         (spec, diff)
     }
 
@@ -347,9 +350,12 @@ impl RoughPlastic {
     /// ([`CoatingTable::diffuse_transmittance`]), chosen with the sampling's probability; the
     /// glossy coating (this model with a black base) is the rest.
     pub fn diffuse_lobe(&self, wo: Vec3) -> DiffuseLobe {
-        let albedo = internal_albedo(self.diffuse, self.table.internal_reflectance, self.nonlinear)
-            * (self.table.at(wo.z.abs()) * self.table.diffuse_transmittance
-                / (self.eta * self.eta));
+        let albedo = internal_albedo(
+            self.diffuse,
+            self.table.internal_reflectance,
+            self.nonlinear,
+        ) * (self.table.at(wo.z.abs()) * self.table.diffuse_transmittance
+            / (self.eta * self.eta));
         DiffuseLobe {
             albedo,
             probability: 1.0 - self.specular_probability(wo),

@@ -116,7 +116,16 @@ fn plastics_match_mitsuba() {
 fn diffuse_fresnel_fits_follow_the_integral() {
     // Mitsuba's fits against `2 ∫ F(μ) μ dμ`: within 0.6% (its own bound) for indices from
     // 1/2 to 2, from either side.
-    for eta in [1.1f32, 1.33, 1.5, 2.0, 1.0 / 1.1, 1.0 / 1.33, 1.0 / 1.5, 0.5] {
+    for eta in [
+        1.1f32,
+        1.33,
+        1.5,
+        2.0,
+        1.0 / 1.1,
+        1.0 / 1.33,
+        1.0 / 1.5,
+        0.5,
+    ] {
         let exact = cosine_mean(|mu| fresnel_dielectric(mu, eta) as f64);
         let fit = fresnel_diffuse_reflectance(eta) as f64;
         assert!(
@@ -157,7 +166,10 @@ fn thin_slab_transmits_straight_through_from_either_side() {
         let r = ThinDielectric::clear(1.5).reflectance_at(wo.z);
         for mode in [RAD, IMP] {
             let t = b.sample(wo, 0.999_999, [0.5; 2], mode).unwrap();
-            assert_eq!((t.wi, t.flags, t.eta), (-wo, Flags::SPECULAR_TRANSMISSION, 1.0));
+            assert_eq!(
+                (t.wi, t.flags, t.eta),
+                (-wo, Flags::SPECULAR_TRANSMISSION, 1.0)
+            );
             assert!((t.pdf - (1.0 - r)).abs() < 1e-6 && (t.weight().x - 1.0).abs() < 1e-5);
             let s = b.sample(wo, 0.0, [0.5; 2], mode).unwrap();
             assert_eq!(s.flags, Flags::SPECULAR_REFLECTION, "{wo}");
@@ -171,7 +183,10 @@ fn thin_slab_transmits_straight_through_from_either_side() {
     let clear: Bsdf = ThinDielectric::clear(1.0).into();
     let s = clear.sample(dir(30.0, 0.0), 0.0, [0.5; 2], RAD).unwrap();
     assert!(s.is_transmission());
-    assert_eq!(Bsdf::from(ThinDielectric::clear(1.5)).glass_eta(), Some(1.0));
+    assert_eq!(
+        Bsdf::from(ThinDielectric::clear(1.5)).glass_eta(),
+        Some(1.0)
+    );
 }
 
 #[test]
@@ -390,10 +405,16 @@ fn coating_table_is_mitsubas_quadrature() {
     // Normal incidence through a nearly smooth coating transmits 1 - F(1) = 0.96 at index 1.5;
     // grazing, nothing; internal reflectance near the smooth F_dr(1/1.5) = 0.596.
     let t = CoatingTable::shared(1e-3, 1.5);
-    assert!((t.transmittance[COATING_RES - 1] - 0.96).abs() < 1e-4, "{t:?}");
+    assert!(
+        (t.transmittance[COATING_RES - 1] - 0.96).abs() < 1e-4,
+        "{t:?}"
+    );
     assert!(t.transmittance[0] < t.transmittance[COATING_RES / 2]);
     assert!((t.internal_reflectance - 0.596).abs() < 0.02, "{t:?}");
-    assert!(std::ptr::eq(t, CoatingTable::shared(1e-3, 1.5)), "computed once");
+    assert!(
+        std::ptr::eq(t, CoatingTable::shared(1e-3, 1.5)),
+        "computed once"
+    );
     // Monotone in the cosine and below 1 - F at each.
     for (i, w) in t.transmittance.windows(2).enumerate() {
         assert!(w[1] >= w[0] - 1e-6, "{i}: {w:?}");
@@ -406,7 +427,12 @@ fn coating_table_is_mitsubas_quadrature() {
 fn plastic_sampling_passes_chi2() {
     // The non-delta samples against `pdf` (the diffuse lobe times its probability); the
     // specular ones are the missing mass, which the test's totals account for.
-    let wo_list = [dir(0.0, 0.0), dir(50.0, 30.0), dir(85.0, 200.0), dir(120.0, 10.0)];
+    let wo_list = [
+        dir(0.0, 0.0),
+        dir(50.0, 30.0),
+        dir(85.0, 200.0),
+        dir(120.0, 10.0),
+    ];
     let b: Bsdf = plastic().into();
     for (k, wo) in wo_list.into_iter().enumerate() {
         chi2_test_sidak(
@@ -425,4 +451,3 @@ fn plastic_sampling_passes_chi2() {
         .unwrap_or_else(|e| panic!("wo {wo}: {e}"));
     }
 }
-
