@@ -95,12 +95,14 @@ def main():
     print("}")
     print()
     print("/// Name, RGB `eta`, RGB `k`.")
+    print("#[rustfmt::skip]")
     print("pub(crate) const CONDUCTORS: &[(&str, [f32; 3], [f32; 3])] = &[")
     for name, eta, k in conductors():
         print(f'    ("{name}", {rgb(eta)}, {rgb(k)}),')
     print("];")
     print()
     print("/// Name, index of refraction.")
+    print("#[rustfmt::skip]")
     print("pub(crate) const IORS: &[(&str, f32)] = &[")
     for name, v in iors():
         print(f'    ("{name}", {f32(v)}),')
