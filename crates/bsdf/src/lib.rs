@@ -19,8 +19,11 @@ mod metal;
 pub mod microfacet;
 mod mirror;
 pub mod optics;
+mod plastic;
 mod rough_conductor;
 mod rough_dielectric;
+mod rough_plastic;
+mod thin_dielectric;
 
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
@@ -29,9 +32,14 @@ pub use lambertian::Lambertian;
 pub use metal::Metal;
 pub use microfacet::TrowbridgeReitz;
 pub use mirror::Mirror;
-pub use optics::{fresnel_conductor, fresnel_dielectric, reflect, refract};
+pub use optics::{
+    fresnel_conductor, fresnel_dielectric, fresnel_diffuse_reflectance, reflect, refract,
+};
+pub use plastic::Plastic;
 pub use rough_conductor::RoughConductor;
 pub use rough_dielectric::RoughDielectric;
+pub use rough_plastic::{COATING_RES, CoatingTable, RoughPlastic};
+pub use thin_dielectric::ThinDielectric;
 
 use glam::Vec3;
 use std::ops::BitOr;
@@ -149,6 +157,9 @@ pub enum Bsdf {
     RoughConductor(RoughConductor),
     RoughDielectric(RoughDielectric),
     Glossy(Glossy),
+    Plastic(Plastic),
+    RoughPlastic(RoughPlastic),
+    ThinDielectric(ThinDielectric),
 }
 
 impl Bsdf {
@@ -164,9 +175,13 @@ impl Bsdf {
             Bsdf::RoughConductor(b) => b.f(wo, wi),
             Bsdf::RoughDielectric(b) => b.f(wo, wi, mode),
             Bsdf::Glossy(b) => b.f(wo, wi),
-            Bsdf::Mirror(_) | Bsdf::Metal(_) | Bsdf::Conductor(_) | Bsdf::Dielectric(_) => {
-                Vec3::ZERO
-            }
+            Bsdf::Plastic(b) => b.f(wo, wi),
+            Bsdf::RoughPlastic(b) => b.f(wo, wi),
+            Bsdf::Mirror(_)
+            | Bsdf::Metal(_)
+            | Bsdf::Conductor(_)
+            | Bsdf::Dielectric(_)
+            | Bsdf::ThinDielectric(_) => Vec3::ZERO,
         }
     }
 
@@ -180,13 +195,18 @@ impl Bsdf {
             Bsdf::RoughConductor(b) => b.pdf(wo, wi),
             Bsdf::RoughDielectric(b) => b.pdf(wo, wi),
             Bsdf::Glossy(b) => b.pdf(wo, wi),
-            Bsdf::Mirror(_) | Bsdf::Metal(_) | Bsdf::Conductor(_) | Bsdf::Dielectric(_) => 0.0,
+            Bsdf::Plastic(b) => b.pdf(wo, wi),
+            Bsdf::RoughPlastic(b) => b.pdf(wo, wi),
+            Bsdf::Mirror(_)
+            | Bsdf::Metal(_)
+            | Bsdf::Conductor(_)
+            | Bsdf::Dielectric(_)
+            | Bsdf::ThinDielectric(_) => 0.0,
         }
     }
 
-    /// Sample `wi` given `wo`: `uc` picks a lobe (dielectrics: reflect or refract; glossy:
-    /// diffuse or GGX), `u` the
-    /// direction within it. `None` when no direction carries energy.
+    /// Sample `wi` given `wo`: `uc` picks a lobe (dielectrics: reflect or refract; glossy and
+    /// plastics: diffuse or the specular one), `u` the direction within it. `None` when no direction carries energy.
     pub fn sample(
         &self,
         wo: Vec3,
@@ -206,16 +226,25 @@ impl Bsdf {
             Bsdf::RoughConductor(b) => b.sample(wo, u),
             Bsdf::RoughDielectric(b) => b.sample(wo, uc, u, mode),
             Bsdf::Glossy(b) => b.sample(wo, uc, u),
+            Bsdf::Plastic(b) => b.sample(wo, uc, u),
+            Bsdf::RoughPlastic(b) => b.sample(wo, uc, u),
+            Bsdf::ThinDielectric(b) => b.sample(wo, uc),
         }?;
         debug_assert!(s.pdf > 0.0 && s.f.is_finite(), "bad sample {s:?}");
         Some(s)
     }
 
     /// True when every lobe is a delta: light sampling cannot help, skip next-event estimation.
+    /// [`Plastic`] is not: its coating's reflection is a delta, its base is not, so it may
+    /// return specular samples while `f` and `pdf` describe its diffuse lobe.
     pub fn is_delta(&self) -> bool {
         matches!(
             self,
-            Bsdf::Mirror(_) | Bsdf::Metal(_) | Bsdf::Conductor(_) | Bsdf::Dielectric(_)
+            Bsdf::Mirror(_)
+                | Bsdf::Metal(_)
+                | Bsdf::Conductor(_)
+                | Bsdf::Dielectric(_)
+                | Bsdf::ThinDielectric(_)
         )
     }
 
@@ -225,10 +254,11 @@ impl Bsdf {
         matches!(self, Bsdf::Lambertian(_))
     }
 
-    /// [`Bsdf::sample`], but for the Glossy model one lobe alone ([`Glossy::sample_lobe`]);
-    /// the flag is true when the lobe sampled is diffuse (a Lambertian model's always), and
-    /// the last value is the whole BSDF's density of `wi` (what MIS weighs), which only the
-    /// Glossy model has to evaluate apart.
+    /// [`Bsdf::sample`], but for the models that sum a diffuse and a glossy lobe one lobe
+    /// alone ([`Glossy::sample_lobe`], [`RoughPlastic::sample_lobe`]); the flag is true when
+    /// the lobe sampled is diffuse (a Lambertian model's always), and the last value is the
+    /// whole BSDF's density of `wi` (what MIS weighs), which only those models have to
+    /// evaluate apart ([`Plastic`]'s lobes never overlap: one is a delta).
     pub fn sample_lobe(
         &self,
         wo: Vec3,
@@ -240,26 +270,34 @@ impl Bsdf {
             Bsdf::Glossy(g) if wo.z != 0.0 => g
                 .sample_lobe(wo, uc, u)
                 .map(|(s, diffuse)| (s, diffuse, g.pdf(wo, s.wi))),
+            Bsdf::RoughPlastic(p) if wo.z != 0.0 => p
+                .sample_lobe(wo, uc, u)
+                .map(|(s, diffuse)| (s, diffuse, p.pdf(wo, s.wi))),
             _ => self
                 .sample(wo, uc, u, mode)
-                .map(|s| (s, matches!(self, Bsdf::Lambertian(_)), s.pdf)),
+                .map(|s| (s, s.flags.is_diffuse(), s.pdf)),
         }
     }
 
-    /// Albedo of the Lambertian lobe, if the model has one (Lambertian, and Glossy's base).
+    /// Albedo of the Lambertian lobe, if the model has one (Lambertian, Glossy's base, the
+    /// plastics' base under their coating).
     pub fn diffuse_albedo(&self) -> Option<Vec3> {
         match self {
             Bsdf::Lambertian(b) => Some(b.albedo),
             Bsdf::Glossy(b) => Some(b.albedo),
+            Bsdf::Plastic(b) => Some(b.diffuse),
+            Bsdf::RoughPlastic(b) => Some(b.diffuse),
             _ => None,
         }
     }
 
-    /// The model's Lambertian lobe as photon estimates split it off (Lambertian: the whole
-    /// model; Glossy: its base, chosen with its sampling probability beside the GGX lobe),
-    /// `None` for models without one. Eye and photon passes ask this rather than match on
-    /// the model, so a new model with a diffuse part is one arm here.
-    pub fn diffuse_lobe(&self) -> Option<DiffuseLobe> {
+    /// The model's Lambertian lobe as photon estimates split it off, seen from `wo` (local
+    /// frame): Lambertian: the whole model; Glossy: its base, chosen with its sampling
+    /// probability beside the GGX lobe; the plastics: their base seen through the coating
+    /// ([`Plastic::diffuse_lobe`], [`RoughPlastic::diffuse_lobe`]), the coating's reflection
+    /// the rest. `None` for models without one. Eye and photon passes ask this rather than
+    /// match on the model, so a new model with a diffuse part is one arm here.
+    pub fn diffuse_lobe(&self, wo: Vec3) -> Option<DiffuseLobe> {
         match self {
             Bsdf::Lambertian(b) => Some(DiffuseLobe {
                 albedo: b.albedo,
@@ -271,16 +309,20 @@ impl Bsdf {
                 probability: g.diffuse_probability(),
                 rest: Some(g.specular_lobe().into()),
             }),
+            Bsdf::Plastic(p) => Some(p.diffuse_lobe(wo)),
+            Bsdf::RoughPlastic(p) => Some(p.diffuse_lobe(wo)),
             _ => None,
         }
     }
 
     /// The relative index of refraction of smooth glass (a delta dielectric), `None` for every
     /// other model: SPPM splits its visible points there by Fresnel branch, and photon
-    /// differentials refract through it.
+    /// differentials refract through it. A thin slab is glass of index 1 here: it reflects
+    /// and transmits by its own Fresnel sum but bends nothing.
     pub fn glass_eta(&self) -> Option<f32> {
         match self {
             Bsdf::Dielectric(d) => Some(d.eta),
+            Bsdf::ThinDielectric(_) => Some(1.0),
             _ => None,
         }
     }
@@ -291,6 +333,14 @@ impl Bsdf {
         match self {
             Bsdf::Lambertian(_) => Bsdf::Lambertian(Lambertian { albedo }),
             Bsdf::Glossy(g) => Bsdf::Glossy(Glossy { albedo, ..g }),
+            Bsdf::Plastic(p) => Bsdf::Plastic(Plastic {
+                diffuse: albedo,
+                ..p
+            }),
+            Bsdf::RoughPlastic(p) => Bsdf::RoughPlastic(RoughPlastic {
+                diffuse: albedo,
+                ..p
+            }),
             other => other,
         }
     }
@@ -307,13 +357,17 @@ impl Bsdf {
             Bsdf::RoughConductor(b) => b.alpha,
             Bsdf::RoughDielectric(b) => b.alpha,
             Bsdf::Glossy(b) => b.alpha,
+            Bsdf::RoughPlastic(b) => b.alpha,
             _ => return None,
         };
         Some(TrowbridgeReitz::new(alpha).alpha_x)
     }
 
     pub fn has_transmission(&self) -> bool {
-        matches!(self, Bsdf::Dielectric(_) | Bsdf::RoughDielectric(_))
+        matches!(
+            self,
+            Bsdf::Dielectric(_) | Bsdf::RoughDielectric(_) | Bsdf::ThinDielectric(_)
+        )
     }
 }
 
@@ -334,7 +388,10 @@ impl_from!(
     Dielectric,
     RoughConductor,
     RoughDielectric,
-    Glossy
+    Glossy,
+    Plastic,
+    RoughPlastic,
+    ThinDielectric
 );
 
 /// Both directions on the same side of the surface (local frame).

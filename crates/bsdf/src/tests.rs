@@ -9,6 +9,7 @@ use math::chi2::chi2_test_sidak;
 use std::f32::consts::{FRAC_1_PI, PI};
 
 mod microfacet;
+mod plastic;
 
 const RAD: TransportMode = TransportMode::Radiance;
 const IMP: TransportMode = TransportMode::Importance;
@@ -62,16 +63,38 @@ fn all_models() -> Vec<(&'static str, Bsdf)> {
         ),
         ("conductor", gold()),
         ("dielectric", glass()),
+        (
+            "tinted conductor",
+            Conductor {
+                reflectance: Vec3::new(0.9, 0.5, 0.7),
+                ..gold_conductor()
+            }
+            .into(),
+        ),
+        ("thin dielectric", ThinDielectric::clear(1.5).into()),
+        (
+            "tinted thin dielectric",
+            ThinDielectric {
+                eta: 1.33,
+                reflectance: Vec3::new(0.9, 0.8, 0.7),
+                transmittance: Vec3::new(0.2, 0.5, 0.9),
+            }
+            .into(),
+        ),
     ]
 }
 
 /// A commonly quoted RGB fit of gold's complex index; any absorbing metal would do here.
 fn gold() -> Bsdf {
+    gold_conductor().into()
+}
+
+fn gold_conductor() -> Conductor {
     Conductor {
         eta: Vec3::new(0.143, 0.374, 1.442),
         k: Vec3::new(3.983, 2.385, 1.603),
+        reflectance: Vec3::ONE,
     }
-    .into()
 }
 
 // --- Construction -----------------------------------------------------------------------
@@ -89,7 +112,10 @@ fn constructors_classify_their_lobes() {
             (true, false, false),
             (true, false, false),
             (true, false, false),
-            (true, false, true)
+            (true, false, true),
+            (true, false, false),
+            (true, false, true),
+            (true, false, true),
         ]
     );
     let f = Flags::REFLECTION | Flags::SPECULAR;
@@ -428,9 +454,14 @@ fn albedos_match_known_values_and_never_exceed_one() {
                 Bsdf::Lambertian(l) => l.albedo,
                 Bsdf::Mirror(m) => m.reflectance,
                 Bsdf::Metal(m) => m.reflectance,
-                Bsdf::Conductor(c) => fresnel_conductor(wo.z, c.eta, c.k),
+                Bsdf::Conductor(c) => c.reflectance * fresnel_conductor(wo.z, c.eta, c.k),
                 // Every sample carries exactly 1: R or T cancels against its probability.
                 Bsdf::Dielectric(_) => Vec3::ONE,
+                // Each lobe carries its factor: R' reflectance + T' transmittance.
+                Bsdf::ThinDielectric(t) => {
+                    let r = t.reflectance_at(wo.z);
+                    r * t.reflectance + (1.0 - r) * t.transmittance
+                }
                 // The GGX models have their own furnace tests (`microfacet`).
                 _ => unreachable!("{name} is not in all_models"),
             };

@@ -187,7 +187,8 @@ fn trace_one(
             // on: light its glossy lobe sends on (L S+ G ...) is the path tracer's. So a
             // Glossy surface goes on as its Lambertian part, chosen with its sampling
             // probability (`uc` rescaled stays uniform for the roulette below).
-            let (bsdf, uc) = match bsdf.diffuse_lobe() {
+            let wo_local = math::Frame::from_z(hit.ns).to_local(-d);
+            let (bsdf, uc) = match bsdf.diffuse_lobe(wo_local) {
                 Some(DiffuseLobe {
                     albedo,
                     probability: pd,
@@ -205,7 +206,7 @@ fn trace_one(
             // albedo at a Lambertian bounce, on the sample's weight at a glossy one.
             if let Some(DiffuseLobe {
                 albedo, rest: None, ..
-            }) = bsdf.diffuse_lobe()
+            }) = bsdf.diffuse_lobe(wo_local)
             {
                 let survive = (albedo * flux).max_element() / flux.max_element();
                 if uc >= survive {

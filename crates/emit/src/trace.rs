@@ -158,9 +158,10 @@ pub(crate) fn bounce(
     u: [f32; 2],
     rng: &mut Rng,
 ) -> Option<(geom::Ray, Vec3, bool)> {
+    let wo_local = Frame::from_z(hit.ns).to_local(-d);
     if let Some(DiffuseLobe {
         albedo, rest: None, ..
-    }) = bsdf.diffuse_lobe()
+    }) = bsdf.diffuse_lobe(wo_local)
     {
         let survive = (albedo * flux).max_element() / flux.max_element();
         if uc >= survive {

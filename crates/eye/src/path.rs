@@ -229,6 +229,11 @@ impl<'a> PathTracer<'a> {
             if !s.is_specular() {
                 diffuse_lobes += diffuse_lobe as u32;
                 last_lobe_diffuse = diffuse_lobe;
+            } else if !bsdf.is_delta() {
+                // A plastic's coating reflection: a delta lobe of a surface photons treat as a
+                // receiver (never part of a caustic photon's specular chain), so a chain from
+                // it to a light is the path tracer's, as one from a glossy lobe is.
+                last_lobe_diffuse = false;
             }
             // MIS against next-event estimation weighs the whole BSDF's density, the one
             // NEE's own weight reads.

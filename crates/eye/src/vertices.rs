@@ -215,7 +215,11 @@ pub(crate) fn first_diffuse(
         // Photon estimates read diffuse lobes only. The Glossy model's two lobes are chosen
         // between with its sampling probability: its Lambertian part is a vertex, its GGX
         // part is followed as a specular bounce is (pbrt-v4's SPPM follows glossy lobes too).
-        let (bsdf, lobe) = match bsdf.diffuse_lobe() {
+        // A plastic's base seen through its coating is a vertex the same way, the coating's
+        // reflection the rest.
+        let frame = Frame::from_z(hit.ns);
+        let wo_l = frame.to_local(wo);
+        let (bsdf, lobe) = match bsdf.diffuse_lobe(wo_l) {
             Some(d) => {
                 // A Lambertian model is its diffuse lobe (probability 1: `beta` unchanged).
                 if d.rest.is_none() || u_lobe < d.probability {
@@ -237,8 +241,6 @@ pub(crate) fn first_diffuse(
             }
             None => (bsdf, 1.0),
         };
-        let frame = Frame::from_z(hit.ns);
-        let wo_l = frame.to_local(wo);
         // Light from a point, spot or directional light reflected by this glossy lobe: no
         // bounce the walk samples can reach a delta light, and neither next-event estimation
         // at a diffuse vertex nor a photon map holds `L G` seen from here, so it is counted

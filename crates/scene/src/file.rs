@@ -465,6 +465,64 @@ pub enum MaterialDesc {
         eta: Option<[f32; 3]>,
         #[serde(default)]
         k: Option<[f32; 3]>,
+        /// Mitsuba 3's named conductor (`"Au"`, `"Cu"`, ...: [`crate::mitsuba_conductor`])
+        /// in place of `eta` and `k`; `"none"` is `reflectance` alone.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        material: Option<String>,
+    },
+    /// A polished metal (Mitsuba 3's `conductor`): specular reflection of `reflectance`
+    /// times the Fresnel term of the complex index `eta + i k` where both are given, or of
+    /// Mitsuba's named `material`, else times 1.
+    Conductor {
+        #[serde(default = "one3", skip_serializing_if = "is_one3")]
+        reflectance: [f32; 3],
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        eta: Option<[f32; 3]>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        k: Option<[f32; 3]>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        material: Option<String>,
+    },
+    /// A `diffuse` base under a smooth dielectric coating of index `ior` (Mitsuba 3's
+    /// `plastic`, `int_ior` over `ext_ior`): the coating's delta reflection times `specular`,
+    /// the base seen through it with its internal reflections summed (`nonlinear`: Mitsuba's
+    /// colour shift of those reflections). `texture` as `lambertian`'s, on `diffuse`.
+    Plastic {
+        diffuse: [f32; 3],
+        #[serde(default = "one3", skip_serializing_if = "is_one3")]
+        specular: [f32; 3],
+        #[serde(default = "plastic_ior")]
+        ior: f32,
+        #[serde(default, skip_serializing_if = "is_false")]
+        nonlinear: bool,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        texture: Option<TextureDesc>,
+    },
+    /// [`MaterialDesc::Plastic`] under a GGX coating of roughness `alpha` (Mitsuba 3's
+    /// `roughplastic` with `distribution = "ggx"`).
+    RoughPlastic {
+        diffuse: [f32; 3],
+        #[serde(default = "one3", skip_serializing_if = "is_one3")]
+        specular: [f32; 3],
+        #[serde(default = "plastic_ior")]
+        ior: f32,
+        #[serde(default = "rough_plastic_alpha")]
+        alpha: f32,
+        #[serde(default, skip_serializing_if = "is_false")]
+        nonlinear: bool,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        texture: Option<TextureDesc>,
+    },
+    /// A thin slab of index `ior` (Mitsuba 3's `thindielectric`): reflects with the slab's
+    /// summed Fresnel reflectance, transmits the rest straight through. `reflectance` and
+    /// `transmittance` are factors on the two lobes.
+    ThinDielectric {
+        #[serde(default = "thin_ior")]
+        ior: f32,
+        #[serde(default = "one3", skip_serializing_if = "is_one3")]
+        reflectance: [f32; 3],
+        #[serde(default = "one3", skip_serializing_if = "is_one3")]
+        transmittance: [f32; 3],
     },
     /// Rough glass (GGX, roughness `alpha`) of index `ior` (Mitsuba 3's `roughdielectric`),
     /// with the smooth glass's `transmittance` and `absorption`.
@@ -525,6 +583,25 @@ fn identity_uv() -> [[f32; 3]; 2] {
 
 fn one3() -> [f32; 3] {
     [1.0; 3]
+}
+
+/// Mitsuba 3's default plastic coating: polypropylene (1.49) in air (1.000277).
+fn plastic_ior() -> f32 {
+    1.49 / 1.000_277
+}
+
+/// Mitsuba 3's default thin slab: BK7 glass (1.5046) in air (1.000277).
+fn thin_ior() -> f32 {
+    1.5046 / 1.000_277
+}
+
+/// Mitsuba 3's default `alpha` of `roughplastic`.
+fn rough_plastic_alpha() -> f32 {
+    0.1
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 // Defaults are not written back: the hashes of a scene without coloured glass (its caches,

@@ -23,6 +23,7 @@ mod file;
 mod lights;
 mod load;
 mod material;
+mod mitsuba_tables;
 mod polygon;
 mod scene;
 mod texture;
@@ -43,6 +44,7 @@ pub use lights::{
 };
 pub use load::fnv1a64;
 pub use material::{ALPHA_RANGE, Material};
+pub use mitsuba_tables::{mitsuba_conductor, mitsuba_ior};
 pub use scene::{AlbedoMap, Scene};
 pub use texture::{Checkerboard, Texture, srgb_to_linear};
 pub use world::{SPHERE_BIT, bsdf_of, sides_agree, surface_id};

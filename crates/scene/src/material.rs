@@ -37,6 +37,33 @@ pub enum Material {
         alpha: f32,
         eta: Option<(Vec3, Vec3)>,
     },
+    /// A polished metal ([`bsdf::Conductor`]): `reflectance` times the Fresnel term of the
+    /// complex index `(eta, k)` where given, else times 1 (Mitsuba 3's `material = "none"`).
+    Conductor {
+        reflectance: Vec3,
+        eta: Option<(Vec3, Vec3)>,
+    },
+    /// A diffuse base under a smooth coating of relative index `ior` ([`bsdf::Plastic`]).
+    Plastic {
+        diffuse: Vec3,
+        specular: Vec3,
+        ior: f32,
+        nonlinear: bool,
+    },
+    /// A diffuse base under a GGX coating ([`bsdf::RoughPlastic`]).
+    RoughPlastic {
+        diffuse: Vec3,
+        specular: Vec3,
+        ior: f32,
+        alpha: f32,
+        nonlinear: bool,
+    },
+    /// A thin slab of relative index `ior` ([`bsdf::ThinDielectric`]).
+    ThinDielectric {
+        ior: f32,
+        reflectance: Vec3,
+        transmittance: Vec3,
+    },
     /// Rough glass: GGX of roughness `alpha` ([`bsdf::RoughDielectric`]), with the smooth
     /// glass's `transmittance` and `absorption`.
     RoughDielectric {
@@ -90,11 +117,17 @@ impl Material {
     }
 
     /// True for the delta (perfectly specular) materials: photons bounce off them and are
-    /// never stored there; a path through them to a diffuse surface is a caustic path.
+    /// never stored there; a path through them to a diffuse surface is a caustic path. A
+    /// plastic is not: its coating's reflection is a delta, but photons are stored on its
+    /// base, and a path reflected by its coating is the path tracer's, as a glossy one is.
     pub fn is_specular(&self) -> bool {
         matches!(
             self,
-            Material::Mirror { .. } | Material::Metal { .. } | Material::Dielectric { .. }
+            Material::Mirror { .. }
+                | Material::Metal { .. }
+                | Material::Dielectric { .. }
+                | Material::Conductor { .. }
+                | Material::ThinDielectric { .. }
         )
     }
 }

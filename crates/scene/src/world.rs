@@ -5,7 +5,10 @@
 
 use crate::material::Material;
 use crate::scene::Scene;
-use bsdf::{Bsdf, Dielectric, Glossy, Lambertian, Metal, Mirror, RoughConductor, RoughDielectric};
+use bsdf::{
+    Bsdf, Conductor, Dielectric, Glossy, Lambertian, Metal, Mirror, Plastic, RoughConductor,
+    RoughDielectric, RoughPlastic, ThinDielectric,
+};
 use geom::{Hit, Prim, Ray};
 use glam::{Vec2, Vec3};
 
@@ -51,6 +54,43 @@ pub fn bsdf_of(m: &Material) -> Option<Bsdf> {
                 alpha,
                 reflectance,
                 eta,
+            }
+            .into(),
+        ),
+        Material::Conductor { reflectance, eta } => {
+            // No index: Mitsuba 3's `none`, `eta + i k = i`, whose Fresnel term is 1.
+            let (eta, k) = eta.unwrap_or((Vec3::ZERO, Vec3::ONE));
+            Some(
+                Conductor {
+                    eta,
+                    k,
+                    reflectance,
+                }
+                .into(),
+            )
+        }
+        Material::Plastic {
+            diffuse,
+            specular,
+            ior,
+            nonlinear,
+        } => Some(Plastic::new(diffuse, specular, ior, nonlinear).into()),
+        Material::RoughPlastic {
+            diffuse,
+            specular,
+            ior,
+            alpha,
+            nonlinear,
+        } => Some(RoughPlastic::new(diffuse, specular, ior, alpha, nonlinear).into()),
+        Material::ThinDielectric {
+            ior,
+            reflectance,
+            transmittance,
+        } => Some(
+            ThinDielectric {
+                eta: ior,
+                reflectance,
+                transmittance,
             }
             .into(),
         ),

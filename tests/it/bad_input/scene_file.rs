@@ -297,9 +297,64 @@ fn cases() -> Vec<Case> {
             &["s.toml: material `white`: ior = 12 must be in (0, 10)"],
         ),
         material(
-            "rough_conductor eta = 0",
-            "type = \"rough_conductor\"\nalpha = 0.1\neta = [0, 1, 1]\nk = [1, 1, 1]",
-            &["s.toml: material `white`: eta = [0, 1, 1] must be finite and > 0"],
+            "rough_conductor eta = k = 0",
+            "type = \"rough_conductor\"\nalpha = 0.1\neta = [0, 1, 1]\nk = [0, 1, 1]",
+            &["s.toml: material `white`: eta = [0, 1, 1], k = [0, 1, 1]: eta or k must be > 0"],
+        ),
+        material(
+            "rough_conductor eta negative",
+            "type = \"rough_conductor\"\nalpha = 0.1\neta = [-1, 1, 1]\nk = [1, 1, 1]",
+            &["s.toml: material `white`: eta = [-1, 1, 1] must be finite and >= 0"],
+        ),
+        material(
+            "conductor unknown material",
+            "type = \"conductor\"\nmaterial = \"gold\"",
+            &["s.toml: material `white`: material = \"gold\" is not one of Mitsuba 3's"],
+        ),
+        material(
+            "conductor material and eta",
+            "type = \"conductor\"\nmaterial = \"Au\"\neta = [1, 1, 1]\nk = [1, 1, 1]",
+            &["s.toml: material `white`: material = \"Au\" and eta, k both give the index"],
+        ),
+        material(
+            "conductor reflectance above 1",
+            "type = \"conductor\"\nreflectance = [1.1, 1, 1]",
+            &["s.toml: material `white`: reflectance = [1.1, 1, 1] must lie in [0, 1]"],
+        ),
+        material(
+            "plastic diffuse above 1",
+            "type = \"plastic\"\ndiffuse = [1.5, 0.5, 0.5]",
+            &["s.toml: material `white`: diffuse = [1.5, 0.5, 0.5] must lie in [0, 1]"],
+        ),
+        material(
+            "plastic specular NaN",
+            "type = \"plastic\"\ndiffuse = [0.5, 0.5, 0.5]\nspecular = [nan, 1, 1]",
+            &["s.toml: material `white`: specular = [NaN, 1, 1] must lie in [0, 1]"],
+        ),
+        material(
+            "plastic ior negative",
+            "type = \"plastic\"\ndiffuse = [0.5, 0.5, 0.5]\nior = -1.5",
+            &["s.toml: material `white`: ior = -1.5 must be in (0, 10)"],
+        ),
+        material(
+            "rough_plastic ior = 1",
+            "type = \"rough_plastic\"\ndiffuse = [0.5, 0.5, 0.5]\nior = 1",
+            &["s.toml: material `white`: ior = 1 leaves no coating"],
+        ),
+        material(
+            "rough_plastic alpha = 0",
+            "type = \"rough_plastic\"\ndiffuse = [0.5, 0.5, 0.5]\nalpha = 0",
+            &["s.toml: material `white`: alpha = 0 must be in [1e-4, 1]"],
+        ),
+        material(
+            "thin_dielectric ior = 0",
+            "type = \"thin_dielectric\"\nior = 0",
+            &["s.toml: material `white`: ior = 0 must be in (0, 10)"],
+        ),
+        material(
+            "thin_dielectric transmittance negative",
+            "type = \"thin_dielectric\"\ntransmittance = [-0.5, 1, 1]",
+            &["s.toml: material `white`: transmittance = [-0.5, 1, 1] must lie in [0, 1]"],
         ),
         material(
             "rough_conductor k negative",

@@ -51,8 +51,20 @@ fn models() -> Vec<(String, Bsdf)> {
         v.push((format!("rough gold a={a}"), rough_gold(a)));
         v.push((format!("rough glass a={a}"), rough_glass(a)));
         v.push((format!("glossy a={a}"), glossy(a)));
+        v.push((format!("rough plastic a={a}"), rough_plastic(a)));
     }
     v
+}
+
+fn rough_plastic(alpha: f32) -> Bsdf {
+    RoughPlastic::new(
+        Vec3::new(0.5, 0.3, 0.1),
+        Vec3::new(0.9, 0.6, 0.3),
+        1.49,
+        alpha,
+        false,
+    )
+    .into()
 }
 
 /// `|a - b| <= rel · max(|a|, |b|)`, or both below `abs`.
@@ -337,7 +349,7 @@ fn samples_agree_with_f_and_pdf() {
         }
         let want: &[usize] = match b {
             Bsdf::RoughDielectric(_) => &[0, 1],
-            Bsdf::Glossy(_) => &[0, 2],
+            Bsdf::Glossy(_) | Bsdf::RoughPlastic(_) => &[0, 2],
             _ => &[0],
         };
         for k in 0..4 {
@@ -381,6 +393,7 @@ fn grazing_and_degenerate_directions_stay_finite() {
         bsdfs.push((format!("conductor a={a}"), rough_gold(a)));
         bsdfs.push((format!("glass a={a}"), rough_glass(a)));
         bsdfs.push((format!("glossy a={a}"), glossy(a)));
+        bsdfs.push((format!("rough plastic a={a}"), rough_plastic(a)));
     }
     let edge = [
         Vec3::Z,
@@ -619,6 +632,11 @@ fn reflection_wos() -> Vec<Vec3> {
 #[test]
 fn rough_conductor_sampling_passes_chi2() {
     chi2_family("rough gold", rough_gold, &reflection_wos(), 4, 1000);
+}
+
+#[test]
+fn rough_plastic_sampling_passes_chi2() {
+    chi2_family("rough plastic", rough_plastic, &reflection_wos(), 4, 1300);
 }
 
 #[test]

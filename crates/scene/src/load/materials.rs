@@ -71,17 +71,68 @@ pub(super) fn of_desc(desc: &MaterialDesc) -> (Material, Vec3) {
             reflectance,
             eta,
             k,
+            material,
         } => (
             Material::RoughConductor {
                 reflectance: Vec3::from(*reflectance),
                 alpha: *alpha,
-                // Both or neither: `validate_materials` refuses one alone.
-                eta: match (eta, k) {
-                    (Some(e), Some(k)) => Some((Vec3::from(*e), Vec3::from(*k))),
-                    (Some(e), None) => Some((Vec3::from(*e), Vec3::NAN)),
-                    (None, Some(k)) => Some((Vec3::NAN, Vec3::from(*k))),
-                    (None, None) => None,
-                },
+                eta: complex_index(*eta, *k, material.as_deref()),
+            },
+            Vec3::ZERO,
+        ),
+        MaterialDesc::Conductor {
+            reflectance,
+            eta,
+            k,
+            material,
+        } => (
+            Material::Conductor {
+                reflectance: Vec3::from(*reflectance),
+                eta: complex_index(*eta, *k, material.as_deref()),
+            },
+            Vec3::ZERO,
+        ),
+        MaterialDesc::Plastic {
+            diffuse,
+            specular,
+            ior,
+            nonlinear,
+            ..
+        } => (
+            Material::Plastic {
+                diffuse: Vec3::from(*diffuse),
+                specular: Vec3::from(*specular),
+                ior: *ior,
+                nonlinear: *nonlinear,
+            },
+            Vec3::ZERO,
+        ),
+        MaterialDesc::RoughPlastic {
+            diffuse,
+            specular,
+            ior,
+            alpha,
+            nonlinear,
+            ..
+        } => (
+            Material::RoughPlastic {
+                diffuse: Vec3::from(*diffuse),
+                specular: Vec3::from(*specular),
+                ior: *ior,
+                alpha: *alpha,
+                nonlinear: *nonlinear,
+            },
+            Vec3::ZERO,
+        ),
+        MaterialDesc::ThinDielectric {
+            ior,
+            reflectance,
+            transmittance,
+        } => (
+            Material::ThinDielectric {
+                ior: *ior,
+                reflectance: Vec3::from(*reflectance),
+                transmittance: Vec3::from(*transmittance),
             },
             Vec3::ZERO,
         ),
@@ -99,6 +150,25 @@ pub(super) fn of_desc(desc: &MaterialDesc) -> (Material, Vec3) {
             },
             Vec3::ZERO,
         ),
+    }
+}
+
+/// A conductor's complex index from its `eta`, `k` and Mitsuba name. Both or neither of `eta`
+/// and `k`, and no name beside them, or a known name: `check_descs` refuses the rest first
+/// (they become NaN here, which `check` would refuse too). `"none"` is no index.
+fn complex_index(
+    eta: Option<[f32; 3]>,
+    k: Option<[f32; 3]>,
+    material: Option<&str>,
+) -> Option<(Vec3, Vec3)> {
+    let v = |x: Option<[f32; 3]>| x.map_or(Vec3::NAN, Vec3::from);
+    match (eta, k, material) {
+        (None, None, None | Some("none")) => None,
+        (None, None, Some(name)) => Some(
+            crate::mitsuba_conductor(name)
+                .map_or((Vec3::NAN, Vec3::NAN), |(e, k)| (e.into(), k.into())),
+        ),
+        (eta, k, _) => Some((v(eta), v(k))),
     }
 }
 
@@ -260,6 +330,26 @@ impl Builder<'_> {
                 }
                 albedo * f
             }
+            Material::Plastic { diffuse, .. } | Material::RoughPlastic { diffuse, .. } => {
+                // As a Lambertian's albedo: the base's reflectance at the brightest texel at
+                // most 1 (the coating is not textured).
+                let peak = diffuse * t_max;
+                let f = to_one(peak);
+                if f != Vec3::ONE {
+                    warning = Some(format!(
+                        "diffuse x texture's brightest texel exceeds 1 in a channel ({} {} {}): \
+                         diffuse scaled there so that texel reflects 1",
+                        peak.x, peak.y, peak.z
+                    ));
+                    if let Some(
+                        Material::Plastic { diffuse, .. } | Material::RoughPlastic { diffuse, .. },
+                    ) = self.materials.get_mut(id as usize)
+                    {
+                        *diffuse *= f;
+                    }
+                }
+                diffuse * f
+            }
             _ => {
                 return Ok(Some(format!(
                     "{map} ({}): only diffuse and glossy (illum 0-2) materials are textured; \
@@ -291,18 +381,41 @@ impl Builder<'_> {
         Ok(())
     }
 
-    /// What the scene file's descriptions say that their [`Material`]s cannot: a rough
-    /// conductor's `eta` or `k` given alone.
+    /// What the scene file's descriptions say that their [`Material`]s cannot: a conductor's
+    /// `eta` or `k` given alone, or beside a named `material`, or a name Mitsuba 3 does not
+    /// know.
     pub(super) fn check_descs(&self, file: &SceneFile) -> Result<(), SceneError> {
         for (name, desc) in &file.materials {
-            if let MaterialDesc::RoughConductor { eta, k, .. } = desc
-                && eta.is_some() != k.is_some()
-            {
+            let (MaterialDesc::RoughConductor {
+                eta, k, material, ..
+            }
+            | MaterialDesc::Conductor {
+                eta, k, material, ..
+            }) = desc
+            else {
+                continue;
+            };
+            if eta.is_some() != k.is_some() {
                 let missing = if eta.is_some() { "k" } else { "eta" };
                 return Err(self.err(format!(
                     "material `{name}`: eta and k are given together or not at all \
                      ({missing} is missing)"
                 )));
+            }
+            if let Some(m) = material {
+                if eta.is_some() {
+                    return Err(self.err(format!(
+                        "material `{name}`: material = \"{m}\" and eta, k both give the index: \
+                         give one"
+                    )));
+                }
+                if m != "none" && crate::mitsuba_conductor(m).is_none() {
+                    return Err(self.err(format!(
+                        "material `{name}`: material = \"{m}\" is not one of Mitsuba 3's \
+                         conductors (e.g. \"Au\", \"Ag\", \"Cu\", \"Al\", \"Cr\", \"none\"; \
+                         names are case-sensitive)"
+                    )));
+                }
             }
         }
         Ok(())
@@ -315,6 +428,12 @@ impl Builder<'_> {
                 texture: Some(t), ..
             }
             | MaterialDesc::Glossy {
+                texture: Some(t), ..
+            }
+            | MaterialDesc::Plastic {
+                texture: Some(t), ..
+            }
+            | MaterialDesc::RoughPlastic {
                 texture: Some(t), ..
             }) = desc
             else {
@@ -409,6 +528,38 @@ pub(super) fn check(m: &Material, key: impl Fn(&str) -> String) -> Result<(), St
             ))
         }
     };
+    let complex = |eta: Option<(Vec3, Vec3)>| {
+        let Some((e, k)) = eta else {
+            return Ok(());
+        };
+        if !non_negative(e) {
+            return Err(format!(
+                "{} = {} must be finite and >= 0 in each channel",
+                key("eta"),
+                list(e)
+            ));
+        }
+        if !non_negative(k) {
+            return Err(format!(
+                "{} = {} must be finite and >= 0 in each channel",
+                key("k"),
+                list(k)
+            ));
+        }
+        // `eta + i k = 0` has no Fresnel term (`eta = 0` with `k > 0` reflects everything,
+        // Mitsuba 3's `none`).
+        if (e + k).min_element() > 0.0 {
+            Ok(())
+        } else {
+            Err(format!(
+                "{} = {}, {} = {}: eta or k must be > 0 in each channel",
+                key("eta"),
+                list(e),
+                key("k"),
+                list(k)
+            ))
+        }
+    };
     match *m {
         Material::Lambertian { albedo } => unit("albedo", albedo),
         Material::Mirror { reflectance } | Material::Metal { reflectance } => {
@@ -449,25 +600,7 @@ pub(super) fn check(m: &Material, key: impl Fn(&str) -> String) -> Result<(), St
         } => {
             unit("reflectance", reflectance)?;
             alpha(a)?;
-            let Some((e, k)) = eta else {
-                return Ok(());
-            };
-            if !(e.is_finite() && e.min_element() > 0.0) {
-                return Err(format!(
-                    "{} = {} must be finite and > 0 in each channel",
-                    key("eta"),
-                    list(e)
-                ));
-            }
-            if non_negative(k) {
-                Ok(())
-            } else {
-                Err(format!(
-                    "{} = {} must be finite and >= 0 in each channel",
-                    key("k"),
-                    list(k)
-                ))
-            }
+            complex(eta)
         }
         Material::RoughDielectric {
             ior: i,
@@ -478,6 +611,48 @@ pub(super) fn check(m: &Material, key: impl Fn(&str) -> String) -> Result<(), St
             glass(transmittance, absorption)?;
             ior(i)?;
             alpha(a)
+        }
+        Material::Conductor { reflectance, eta } => {
+            unit("reflectance", reflectance)?;
+            complex(eta)
+        }
+        Material::Plastic {
+            diffuse,
+            specular,
+            ior: i,
+            ..
+        } => {
+            unit("diffuse", diffuse)?;
+            unit("specular", specular)?;
+            ior(i)
+        }
+        Material::RoughPlastic {
+            diffuse,
+            specular,
+            ior: i,
+            alpha: a,
+            ..
+        } => {
+            unit("diffuse", diffuse)?;
+            unit("specular", specular)?;
+            ior(i)?;
+            // Mitsuba 3 refuses it too: the coating's tables need an interface.
+            if i == 1.0 {
+                return Err(format!(
+                    "{} = 1 leaves no coating: use lambertian",
+                    key("ior")
+                ));
+            }
+            alpha(a)
+        }
+        Material::ThinDielectric {
+            ior: i,
+            reflectance,
+            transmittance,
+        } => {
+            unit("reflectance", reflectance)?;
+            unit("transmittance", transmittance)?;
+            ior(i)
         }
     }
 }

@@ -156,11 +156,12 @@ fn the_worksheet_in_xml_is_the_worksheet() {
         // `metal` and a conductor with no index are the same constant reflectance.
         match (mx, mt) {
             (
-                crate::Material::Mirror { reflectance: a },
+                crate::Material::Conductor {
+                    reflectance: a,
+                    eta: None,
+                },
                 crate::Material::Metal { reflectance: b },
-            ) => {
-                assert_eq!(a, b)
-            }
+            ) => assert_eq!(a, b),
             (a, b) => assert_eq!(a, b),
         }
     }

@@ -462,7 +462,7 @@ impl<'a> Converter<'a> {
                 }
             }
             "dielectric" | "roughdielectric" => {
-                let ior = ior(&p)?;
+                let ior = ior(&p, 1.5046)?;
                 let transmittance = p.rgb("specular_transmittance", [1.0; 3])?;
                 if p.rgb("specular_reflectance", [1.0; 3])? != [1.0; 3] {
                     return Err(p.err(
@@ -488,28 +488,66 @@ impl<'a> Converter<'a> {
             "conductor" | "roughconductor" => {
                 one_sided(self);
                 let reflectance = p.rgb("specular_reflectance", [1.0; 3])?;
-                let (eta, k) = conductor_index(&p)?;
+                let (eta, k, material) = conductor_index(&p)?;
                 if p.kind == "conductor" {
-                    if eta.is_some() {
-                        return Err(p.err(
-                            "a smooth conductor with a complex index: not read by this build of \
-                             photonflow (a `roughconductor` is)",
-                        ));
+                    MaterialDesc::Conductor {
+                        reflectance,
+                        eta,
+                        k,
+                        material,
                     }
-                    MaterialDesc::Mirror { reflectance }
                 } else {
                     MaterialDesc::RoughConductor {
                         alpha: self.alpha(&p)?,
                         reflectance,
                         eta,
                         k,
+                        material,
+                    }
+                }
+            }
+            "thindielectric" => {
+                let ior = ior(&p, 1.5046)?;
+                MaterialDesc::ThinDielectric {
+                    ior,
+                    reflectance: p.rgb("specular_reflectance", [1.0; 3])?,
+                    transmittance: p.rgb("specular_transmittance", [1.0; 3])?,
+                }
+            }
+            "plastic" | "roughplastic" => {
+                one_sided(self);
+                let ior = ior(&p, 1.49)?;
+                let specular = p.rgb("specular_reflectance", [1.0; 3])?;
+                let nonlinear = p.boolean("nonlinear")?.unwrap_or(false);
+                let (diffuse, texture) = match p.color("diffuse_reflectance")? {
+                    None => ([0.5; 3], None),
+                    Some(Color::Rgb(d)) => (d, None),
+                    Some(Color::Texture(t)) => ([1.0; 3], Some(self.texture(t)?)),
+                };
+                if p.kind == "plastic" {
+                    MaterialDesc::Plastic {
+                        diffuse,
+                        specular,
+                        ior,
+                        nonlinear,
+                        texture,
+                    }
+                } else {
+                    MaterialDesc::RoughPlastic {
+                        diffuse,
+                        specular,
+                        ior,
+                        alpha: self.alpha(&p)?,
+                        nonlinear,
+                        texture,
                     }
                 }
             }
             _ => {
                 return Err(p.err(
-                    "not a BSDF photonflow reads (diffuse, dielectric, roughdielectric, \
-                     conductor, roughconductor, twosided)",
+                    "not a BSDF photonflow reads (diffuse, dielectric, thindielectric, \
+                     roughdielectric, conductor, roughconductor, plastic, roughplastic, \
+                     twosided)",
                 ));
             }
         };
@@ -677,22 +715,23 @@ impl<'a> Converter<'a> {
     }
 }
 
-/// `int_ior / ext_ior`, each a number or one of Mitsuba 3's named materials.
-fn ior(p: &Plugin) -> Result<f32, SceneError> {
+/// `int_ior / ext_ior`, each a number or one of Mitsuba 3's named materials (`int_ior`
+/// defaults to `int_default`, `ext_ior` to air).
+fn ior(p: &Plugin, int_default: f64) -> Result<f32, SceneError> {
     let side = |key: &str, default: f64| -> Result<f64, SceneError> {
         if p.tag_of(key) != Some("string") {
             return Ok(p.float(key)?.unwrap_or(default));
         }
         match p.string(key)? {
             None => Ok(default),
-            Some(name) => named_ior(name).ok_or_else(|| {
+            Some(name) => crate::mitsuba_ior(name).map(f64::from).ok_or_else(|| {
                 p.err(format_args!(
                     "{key} `{name}`: not one of Mitsuba 3's named indices"
                 ))
             }),
         }
     };
-    let int = side("int_ior", 1.5046)?;
+    let int = side("int_ior", int_default)?;
     let ext = side("ext_ior", 1.000277)?;
     if !(int > 0.0 && ext > 0.0) {
         return Err(p.err("int_ior and ext_ior must be positive"));
@@ -700,50 +739,24 @@ fn ior(p: &Plugin) -> Result<f32, SceneError> {
     Ok((int / ext) as f32)
 }
 
-/// Mitsuba 3's table of named refractive indices.
-fn named_ior(name: &str) -> Option<f64> {
-    Some(match name {
-        "vacuum" => 1.0,
-        "helium" => 1.00004,
-        "hydrogen" => 1.00013,
-        "air" => 1.000277,
-        "carbon dioxide" => 1.00045,
-        "water" => 1.3330,
-        "acetone" => 1.36,
-        "ethanol" => 1.361,
-        "carbon tetrachloride" => 1.461,
-        "glycerol" => 1.4729,
-        "benzene" => 1.501,
-        "silicone oil" => 1.52045,
-        "bromine" => 1.661,
-        "water ice" => 1.31,
-        "fused quartz" => 1.458,
-        "pyrex" => 1.470,
-        "acrylic glass" => 1.49,
-        "polypropylene" => 1.49,
-        "bk7" => 1.5046,
-        "sodium chloride" => 1.544,
-        "amber" => 1.55,
-        "pet" => 1.5750,
-        "diamond" => 2.419,
-        _ => return None,
-    })
-}
-
-/// A conductor's complex index: `eta` and `k` given, or `material` (`none`, the default, is
-/// a perfect mirror: no index).
-type Index = (Option<[f32; 3]>, Option<[f32; 3]>);
+/// A conductor's complex index: `eta` and `k` given, or Mitsuba 3's named `material` (the
+/// scene file checks the name; `none`, the default, is a perfect mirror).
+type Index = (Option<[f32; 3]>, Option<[f32; 3]>, Option<String>);
 fn conductor_index(p: &Plugin) -> Result<Index, SceneError> {
     let eta = p.color("eta")?;
     let k = p.color("k")?;
     let material = p.string("material")?;
     match (eta, k, material) {
-        (None, None, None | Some("none")) => Ok((None, None)),
-        (Some(Color::Rgb(e)), Some(Color::Rgb(k)), None) => Ok((Some(e), Some(k))),
-        (None, None, Some(m)) => Err(p.err(format_args!(
-            "material `{m}`: Mitsuba 3's named conductors are not read by this build of \
-             photonflow (give `eta` and `k` as <rgb>)"
-        ))),
+        (None, None, None) => Ok((None, None, None)),
+        (Some(Color::Rgb(e)), Some(Color::Rgb(k)), None) => Ok((Some(e), Some(k), None)),
+        (None, None, Some(m)) => {
+            if m != "none" && crate::mitsuba_conductor(m).is_none() {
+                return Err(p.err(format_args!(
+                    "material `{m}`: not one of Mitsuba 3's named conductors"
+                )));
+            }
+            Ok((None, None, Some(m.to_string())))
+        }
         _ => Err(p.err("give both `eta` and `k` as <rgb>, or `material`")),
     }
 }
