@@ -2,8 +2,10 @@
 //! Mitsuba 3 write it): a text header of elements and their properties, then a body in
 //! `ascii`, `binary_little_endian` or `binary_big_endian`. What is read: `element vertex`
 //! with `x y z` (any scalar type), `nx ny nz` when all three are there, and the first of the
-//! texture-coordinate pairs `u v`, `s t`, `texture_u texture_v`, `texture_s texture_t`, kept
-//! as written (v up, as OBJ's `vt`, which is what Blender and MeshLab write); `element face`
+//! texture-coordinate pairs `u v`, `s t`, `texture_u texture_v`, `texture_s texture_t`, read
+//! as Mitsuba 3 reads them (`v` from the image's top: a PLY's `v` is 1 minus the OBJ `vt` of
+//! the same point, as Mitsuba's `write_ply` of an OBJ shows; Blender and MeshLab count `v`
+//! up instead, so their textured PLY files come out flipped, here as in Mitsuba); `element face`
 //! with its `vertex_indices` (or `vertex_index`) list, each polygon triangulated by
 //! `faces.rs` as an OBJ's is. Every other element and property is read past, lists
 //! included. A PLY file has no materials: the mesh's `material` key names one of the scene
@@ -12,8 +14,8 @@
 //! Hand-written rather than a crate: the maintained `ply-rs-bw` (2.0.3) panics on an element
 //! count too long for `usize` (an `unwrap` in its header grammar) and allocates a vector of
 //! the header's claimed count before reading a byte (`element vertex 4000000000000000`
-//! aborts the process asking for 288 PB), and the unmaintained `ply-rs` it forks does the
-//! same; neither names the element or line at fault. The format is small enough that a
+//! aborts the process asking for 288 PB; `ply-rs`, which it forks, is unmaintained), and its
+//! errors do not name the element at fault. The format is small enough that a
 //! reader here is shorter than the checks around a crate would be: every count is checked
 //! against the bytes that follow before anything is read or allocated by it, every problem
 //! is a one-line message, and no input reaches a panic (the `deny` lints of `mod.rs`).
@@ -401,7 +403,8 @@ impl<'a> Body<'a> {
             usize::try_from(n).map_err(|_| Miss::Bad(format!("list `{name}` has length {n}")))?;
         if n.saturating_mul(item_size) > self.remaining() {
             return Err(Miss::Bad(format!(
-                "list `{name}` claims {n} items, but only {} bytes follow",
+                "list `{name}` claims {n} items of at least {item_size} bytes each, but {} \
+                 bytes follow: the length is absurd or the file is cut short",
                 self.remaining()
             )));
         }
@@ -612,7 +615,10 @@ fn read_vertex(
         mesh.normals.extend(n);
     }
     if has_uv {
-        mesh.texcoords.extend(uv.map(|x| x as f32));
+        // Counted down from the image's top, as Mitsuba 3 writes and reads PLY files: OBJ's
+        // `vt` (and the textures here) count up, so `v` turns over.
+        let [u, v] = uv;
+        mesh.texcoords.extend([u as f32, (1.0 - v) as f32]);
     }
     Ok(())
 }
