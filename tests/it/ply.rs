@@ -1,7 +1,8 @@
 //! A scene of PLY meshes renders the image of the same meshes given as one OBJ, bit for bit,
 //! through the command line: a textured floor (texture coordinates), a box of flat faces
 //! with their normals, an octahedron with smooth vertex normals, and a light, all under one
-//! transform, each PLY file in another encoding.
+//! transform, each PLY file in another encoding. The run's `scene.toml` names the PLY files
+//! by absolute path.
 
 use crate::kit::{TempDir, bits, cli};
 use tests::ply::{Format, Mesh, write};
@@ -208,6 +209,13 @@ fn a_ply_scene_renders_as_the_same_obj_scene() {
         assert!(
             bits(&obj) == bits(&ply),
             "{args}: the PLY scene draws another image"
+        );
+        // The run's `scene.toml` names the PLY files by absolute path, as it does OBJ files.
+        let resolved = std::fs::read_to_string(d.join("out-ply/scene.toml")).unwrap();
+        let part = std::path::absolute(d.join("part0.ply")).unwrap();
+        assert!(
+            resolved.contains(&format!("ply = {:?}", part.display().to_string())),
+            "{resolved}"
         );
         let _ = std::fs::remove_dir_all(d.join("out-obj"));
         let _ = std::fs::remove_dir_all(d.join("out-ply"));

@@ -68,9 +68,21 @@ fn white(
     words: &'static [&'static str],
     check: Option<Check>,
 ) -> Case {
+    let files = files(scene(""), OBJ, &MTL.replace("Kd 0.5 0.5 0.5", lines));
+    info_case(name, files, words, check)
+}
+
+/// A case of `files` run through `info`: refused with `words`, or, with none, loaded and
+/// checked by `check`.
+fn info_case(
+    name: &'static str,
+    files: Vec<(&'static str, Input)>,
+    words: &'static [&'static str],
+    check: Option<Check>,
+) -> Case {
     Case {
         name,
-        files: files(scene(""), OBJ, &MTL.replace("Kd 0.5 0.5 0.5", lines)),
+        files,
         setup: vec![],
         prepare: None,
         args: "info {d}/s.toml",
@@ -475,16 +487,12 @@ fn ply_case(
     words: &'static [&'static str],
     check: Option<Check>,
 ) -> Case {
-    Case {
+    info_case(
         name,
-        files: with(files(scene(toml), OBJ, MTL), "p.ply", ply),
-        setup: vec![],
-        prepare: None,
-        args: "info {d}/s.toml",
-        code: if words.is_empty() { 0 } else { 1 },
+        with(files(scene(toml), OBJ, MTL), "p.ply", ply),
         words,
         check,
-    }
+    )
 }
 
 fn ply_cases() -> Vec<Case> {

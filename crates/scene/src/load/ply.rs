@@ -423,7 +423,7 @@ impl<'a> Body<'a> {
                     }
                 } else {
                     // Checked by `list_len`: n items fit in what follows.
-                    self.pos += n * item.size();
+                    self.pos = self.pos.saturating_add(n.saturating_mul(item.size()));
                 }
                 Ok(())
             }

@@ -190,6 +190,7 @@ fn ascii_and_binary_bodies_load_the_same_triangles() {
             (&n.positions, &n.normals, &n.texcoords, &n.indices)
         );
     }
+    assert_eq!((m.normals.len(), m.texcoords.len()), (12, 12));
     for (v, ((p, n), uv)) in m
         .positions
         .iter()
