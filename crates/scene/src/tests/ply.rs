@@ -1,7 +1,7 @@
 //! PLY loading: one mesh in the three encodings, polygons, normals and texture coordinates,
 //! files Mitsuba 3 wrote (`data/`), the `material` key, and every problem named with its file.
 
-use super::{CAMERA, Scratch, close, error_of};
+use super::{CAMERA, Scratch, close};
 use crate::Scene;
 use crate::load::ply::parse;
 use glam::{Vec2, Vec3};
@@ -240,7 +240,8 @@ fn polygons_are_triangulated_with_their_area() {
 }
 
 /// `normals`: the file's under `auto` (through the transform's inverse transpose), none under
-/// `flat`, computed under `smooth`; the transform applies to the vertices.
+/// `flat`, computed under `smooth`; `flip_normals` turns faces over; the transform applies to
+/// the vertices.
 #[test]
 fn normals_follow_the_mesh_keys() {
     let ply = mixed("binary_little_endian");
@@ -258,6 +259,17 @@ fn normals_follow_the_mesh_keys() {
         "{}",
         m.positions[9]
     );
+    // `flip_normals`: every face turned over, its vertex normals too.
+    let plain = ply_scene("plain", "", &ply);
+    let flipped = ply_scene("flip", "flip_normals = true", &ply);
+    let (p, f) = (plain.geometry.mesh(), flipped.geometry.mesh());
+    assert!(
+        f.normals.iter().all(|n| *n == Vec3::NEG_Y),
+        "{:?}",
+        f.normals
+    );
+    let turned: Vec<[u32; 3]> = p.indices.iter().map(|&[a, b, c]| [a, c, b]).collect();
+    assert_eq!(f.indices, turned);
     let flat = ply_scene("flat", "normals = \"flat\"", &ply);
     assert!(flat.geometry.mesh().normals.is_empty());
     let smooth = ply_scene("smooth", "normals = \"smooth\"", &ply);
@@ -518,37 +530,25 @@ fn the_mesh_keys_are_checked() {
     refused(
         "nomat",
         ply_toml("").replace("material = \"white\"\n", ""),
-        "mesh 0 (m.ply): a PLY mesh needs `material = \"name\"`, one of the scene file's \
-         materials (known: `white`)",
+        "mesh 0 (m.ply): a PLY mesh needs `material = \"name\"`: the file has no materials \
+         (known: white)",
     );
     refused(
         "unknownmat",
         ply_toml("").replace("material = \"white\"", "material = \"whyte\""),
-        "mesh 0 (m.ply): unknown material `whyte` (known: `white`)",
+        "mesh 0 (m.ply): unknown material `whyte`",
     );
-    refused(
-        "both",
-        ply_toml("obj = \"a.obj\""),
-        "both `obj = \"a.obj\"` and `ply = \"m.ply\"`",
-    );
+    let one_of = "give exactly one of `obj` or `ply` (a file) and `shape`";
+    refused("both", ply_toml("obj = \"a.obj\""), one_of);
+    refused("shape-too", ply_toml("shape = \"cube\""), one_of);
     refused(
         "neither",
         ply_toml("").replace("ply = \"m.ply\"\n", ""),
-        "mesh 0: no file: give `obj = \"name.obj\"` or `ply = \"name.ply\"`",
+        one_of,
     );
-    error_of(
-        "objmat",
-        &[
-            (
-                "s.toml",
-                &(super::scene_toml("a.obj") + "material = \"white\"\n"),
-            ),
-            ("a.obj", super::GOOD_OBJ),
-            ("m.mtl", super::GOOD_MTL),
-        ],
-        "s.toml",
-        "`material` is for PLY meshes",
-    );
+    // `radiance` makes the PLY's faces emit, as an OBJ's under `material`.
+    let lit = load_ply("radiance", &ply_toml("radiance = [2, 2, 2]"), &good).unwrap();
+    assert_eq!(lit.lights.len(), 1);
     let missing = Scratch::new("noply", &[("s.toml", &ply_toml(""))]);
     let err = Scene::load(missing.path("s.toml")).err().unwrap();
     assert!(err.file.ends_with("m.ply"), "{err}");
