@@ -588,3 +588,28 @@ fn ply_content_keys_the_hashes_and_emits() {
     .unwrap();
     assert_eq!(s.lights.len(), 1);
 }
+
+/// A Mitsuba 3 XML scene's `<shape type="ply">` is a PLY mesh of its BSDF: the cube Mitsuba
+/// wrote, placed by `to_world`.
+#[test]
+fn xml_ply_shapes_load() {
+    let xml = r#"<scene version="3.0.0">
+    <sensor type="perspective"><float name="fov" value="40"/>
+        <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/><rfilter type="box"/></film>
+    </sensor>
+    <shape type="ply"><string name="filename" value="cube.ply"/>
+        <transform name="to_world"><scale value="0.5"/><translate z="5"/></transform>
+        <bsdf type="diffuse"/>
+    </shape>
+    <emitter type="point"><point name="position" x="0" y="0" z="0"/></emitter>
+</scene>"#;
+    let dir = Scratch::new("xml-ply", &[("s.xml", xml)]);
+    std::fs::copy(data("mitsuba-cube.ply"), dir.path("cube.ply")).unwrap();
+    let s = Scene::load(dir.path("s.xml")).unwrap_or_else(|e| panic!("{e}"));
+    let m = s.geometry.mesh();
+    assert_eq!(m.len(), 12);
+    let area: f64 = (0..m.len()).map(|t| m.area(t) as f64).sum();
+    assert!((area - 6.0).abs() < 1e-5, "area {area}");
+    assert!(m.positions.iter().all(|p| (p.z - 5.0).abs() <= 0.5 + 1e-6));
+    assert_eq!(s.file.meshes[0].ply.as_deref(), Some("cube.ply"));
+}
