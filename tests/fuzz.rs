@@ -21,6 +21,11 @@ pub enum Target {
     Obj,
     /// The MTL reader (the OBJ's material library).
     Mtl,
+    /// The PLY reader, on a binary (little-endian) file with normals and texture
+    /// coordinates, mutated as binary.
+    Ply,
+    /// The PLY reader on the same mesh in ASCII, mutated as text.
+    PlyAscii,
     /// The scene file (TOML) and the settings tables the pipeline parses from it.
     Scene,
     /// The photon-file readers (streaming and memory-mapped).
@@ -30,9 +35,11 @@ pub enum Target {
 }
 
 impl Target {
-    pub const ALL: [Target; 5] = [
+    pub const ALL: [Target; 7] = [
         Target::Obj,
         Target::Mtl,
+        Target::Ply,
+        Target::PlyAscii,
         Target::Scene,
         Target::Photons,
         Target::Exr,
@@ -42,6 +49,8 @@ impl Target {
         match self {
             Target::Obj => "obj",
             Target::Mtl => "mtl",
+            Target::Ply => "ply",
+            Target::PlyAscii => "ply-ascii",
             Target::Scene => "scene",
             Target::Photons => "photons",
             Target::Exr => "exr",
@@ -49,7 +58,10 @@ impl Target {
     }
 
     fn is_text(self) -> bool {
-        matches!(self, Target::Obj | Target::Mtl | Target::Scene)
+        matches!(
+            self,
+            Target::Obj | Target::Mtl | Target::PlyAscii | Target::Scene
+        )
     }
 }
 
@@ -113,7 +125,7 @@ const NUMBERS: [&str; 14] = [
 ];
 
 /// Lines and words that mean something to one of the text formats.
-const WORDS: [&str; 16] = [
+const WORDS: [&str; 22] = [
     "f 1 2 3",
     "f -1 -2 -3",
     "f 1/1/1 2//2 3",
@@ -130,6 +142,12 @@ const WORDS: [&str; 16] = [
     "width = 0",
     "radius = -1",
     "photons = 1000000000000",
+    "element vertex 4000000000",
+    "property list uchar int vertex_indices",
+    "property float nx",
+    "property list float int vertex_indices",
+    "end_header",
+    "255 0 1 2",
 ];
 
 /// Interesting machine words for binary formats.
@@ -219,6 +237,8 @@ struct Corpus {
     dir: PathBuf,
     obj: Vec<u8>,
     mtl: Vec<u8>,
+    ply: Vec<u8>,
+    ply_ascii: Vec<u8>,
     scene: Vec<u8>,
     photons: Vec<u8>,
     exr: Vec<u8>,
@@ -286,6 +306,12 @@ obj = \"box.obj\"
 scale = 1.0
 emission = \"ka\"
 
+[[mesh]]
+ply = \"box.ply\"
+material = \"grey\"
+translate = [0.0, 0.5, 0.0]
+normals = \"auto\"
+
 [[sphere]]
 center = [0.3, 0.3, 0.0]
 radius = 0.3
@@ -294,6 +320,10 @@ material = \"glass\"
 [material.glass]
 type = \"dielectric\"
 ior = 1.5
+
+[material.grey]
+type = \"lambertian\"
+albedo = [0.5, 0.5, 0.5]
 
 [photons]
 photons = 1000
@@ -338,6 +368,8 @@ impl Corpus {
             dir: dir.to_path_buf(),
             obj: OBJ.as_bytes().to_vec(),
             mtl: MTL.as_bytes().to_vec(),
+            ply: crate::ply::write(crate::ply::Format::Little, &ply_mesh()),
+            ply_ascii: crate::ply::write(crate::ply::Format::Ascii, &ply_mesh()),
             scene: SCENE.as_bytes().to_vec(),
             photons: read(&photons_path)?,
             exr: read(&exr_path)?,
@@ -348,6 +380,8 @@ impl Corpus {
         match t {
             Target::Obj => &self.obj,
             Target::Mtl => &self.mtl,
+            Target::Ply => &self.ply,
+            Target::PlyAscii => &self.ply_ascii,
             Target::Scene => &self.scene,
             Target::Photons => &self.photons,
             Target::Exr => &self.exr,
@@ -362,9 +396,10 @@ impl Corpus {
             std::fs::write(d.join(name), if t_is(t, name) { input } else { valid })
         };
         Ok(match t {
-            Target::Obj | Target::Mtl | Target::Scene => {
+            Target::Obj | Target::Mtl | Target::Ply | Target::PlyAscii | Target::Scene => {
                 file("box.obj", &self.obj)?;
                 file("box.mtl", &self.mtl)?;
+                file("box.ply", &self.ply)?;
                 file("scene.toml", &self.scene)?;
                 match scene::Scene::load(d.join("scene.toml")) {
                     Ok(s) => {
@@ -393,8 +428,46 @@ impl Corpus {
 fn t_is(t: Target, name: &str) -> bool {
     matches!(
         (t, name),
-        (Target::Obj, "box.obj") | (Target::Mtl, "box.mtl") | (Target::Scene, "scene.toml")
+        (Target::Obj, "box.obj")
+            | (Target::Mtl, "box.mtl")
+            | (Target::Ply | Target::PlyAscii, "box.ply")
+            | (Target::Scene, "scene.toml")
     )
+}
+
+/// The PLY target's mesh: a box's five faces (quads) and a triangle in its top, with
+/// normals and texture coordinates.
+fn ply_mesh() -> crate::ply::Mesh {
+    let mut m = crate::ply::Mesh::default();
+    let quads = [
+        ([0.0, -0.5, 0.0], [0.0, -1.0, 0.0]),
+        ([-0.5, 0.0, 0.0], [-1.0, 0.0, 0.0]),
+        ([0.5, 0.0, 0.0], [1.0, 0.0, 0.0]),
+        ([0.0, 0.0, -0.5], [0.0, 0.0, -1.0]),
+        ([0.0, 0.0, 0.5], [0.0, 0.0, 1.0]),
+    ];
+    for (c, n) in quads {
+        let axis = n.iter().position(|x: &f32| *x != 0.0).unwrap_or(0);
+        let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+        let base = m.positions.len() as i32;
+        for (s, t) in [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)] {
+            let mut p: [f32; 3] = c;
+            p[a] += s;
+            p[b] += t;
+            m.positions.push(p);
+            m.normals.push(n);
+            m.uvs.push([s + 0.5, t + 0.5]);
+        }
+        m.faces.push((base..base + 4).collect());
+    }
+    let base = m.positions.len() as i32;
+    for p in [[-0.2, 0.5, -0.2], [0.2, 0.5, -0.2], [0.0, 0.5, 0.2]] {
+        m.positions.push(p);
+        m.normals.push([0.0, 1.0, 0.0]);
+        m.uvs.push([0.5, 0.5]);
+    }
+    m.faces.push(vec![base, base + 1, base + 2]);
+    m
 }
 
 /// Runs `target`'s loop from `seed` in `dir` (a scratch directory) for `budget`. A failure

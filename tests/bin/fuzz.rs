@@ -29,7 +29,7 @@ fn main() -> std::process::ExitCode {
         if !parsed {
             eprintln!(
                 "fuzz: bad argument `{a}`: usage: fuzz [--seconds N] [--seed S] \
-                 [--target obj|mtl|scene|photons|exr]"
+                 [--target obj|mtl|ply|ply-ascii|scene|photons|exr]"
             );
             return std::process::ExitCode::FAILURE;
         }

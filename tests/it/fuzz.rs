@@ -1,6 +1,6 @@
 //! The fuzz loops of `tests::fuzz` at the size `cargo test` affords: 3,000 mutated inputs per
-//! loader (OBJ, MTL, scene file, photon file, EXR), each one answered without a panic, a hang
-//! or an allocation sized by an unchecked field. `cargo xtask fuzz --seconds N` runs more.
+//! loader (OBJ, MTL, PLY binary and ASCII, scene file, photon file, EXR), each one answered
+//! without a panic, a hang or an allocation sized by an unchecked field. `cargo xtask fuzz --seconds N` runs more.
 
 use crate::kit::TempDir;
 use tests::fuzz::{Budget, Target, run};
@@ -26,6 +26,16 @@ fn obj_loader_survives_mutations() {
 #[test]
 fn mtl_reader_survives_mutations() {
     fuzz(Target::Mtl);
+}
+
+#[test]
+fn ply_reader_survives_binary_mutations() {
+    fuzz(Target::Ply);
+}
+
+#[test]
+fn ply_reader_survives_text_mutations() {
+    fuzz(Target::PlyAscii);
 }
 
 #[test]

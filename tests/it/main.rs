@@ -24,6 +24,9 @@
 //! - `point_lights`: point and spot lights against closed forms (`ρ/π I cos θ / r²` over a
 //!   plane in the path tracer and SPPM, a spot's beam, ramp and cutoff), and a point light in
 //!   the glass sphere whose light only photons find.
+//! - `ply`: a scene of PLY meshes (ASCII, little- and big-endian; texture coordinates, flat
+//!   and smooth normals, polygons) renders the image of the same meshes as one OBJ, bit for
+//!   bit, through `photonflow render` (the path tracer and SPPM).
 //! - `light_tracing`: light paths joined to the camera (`--method light`): the worksheet's
 //!   area light seen directly at its radiance.
 //! - `references`: every method's images of the reference scenes against Mitsuba 3's
@@ -66,6 +69,7 @@ mod kit;
 mod light_tracing;
 mod photon_maps;
 mod photons;
+mod ply;
 mod point_lights;
 mod references;
 mod shards;

@@ -14,7 +14,7 @@
 #             cornell-textured, cornell-coloured-glass, furnace, plane-light, corner,
 #             point-caustic, cornell-spot, environment, mcguire-original, mcguire-sphere,
 #             mcguire-mirror, mcguire-water, mcguire-glossy, mitsuba-worksheet,
-#             mitsuba-shapes-and-lights (default: all)
+#             mitsuba-shapes-and-lights, mitsuba-materials (default: all)
 # SPP_POINT, SPP_SPOT, SPP_ENV  spp per half of point-caustic, cornell-spot, environment
 #             (default 24576, 8192, 24576)
 # SPP_MCGUIRE spp per half of mcguire-sphere, -mirror, -water and -glossy (default 8192)
@@ -141,7 +141,7 @@ SPP_MCGUIRE=${SPP_MCGUIRE:-8192}
 P=$PEERS/worksheet
 S=$REPO/scenes
 names=("$@")
-[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough cornell-textured cornell-coloured-glass furnace plane-light corner point-caustic cornell-spot environment mcguire-original mcguire-sphere mcguire-mirror mcguire-water mcguire-glossy mitsuba-worksheet mitsuba-shapes-and-lights)
+[ ${#names[@]} -gt 0 ] || names=(cornell-spheres-analytic cornell-spheres-closeup cornell-glossy cornell-rough cornell-textured cornell-coloured-glass furnace plane-light corner point-caustic cornell-spot environment mcguire-original mcguire-sphere mcguire-mirror mcguire-water mcguire-glossy mitsuba-worksheet mitsuba-shapes-and-lights mitsuba-materials)
 if [ "$BENCH" = 1 ]; then
   for n in "${names[@]}"; do
     case $n in
@@ -217,6 +217,8 @@ for n in "${names[@]}"; do
       render_xml $n "$S/mitsuba/worksheet.xml" 128 128 4096 1024 ;;
     mitsuba-shapes-and-lights)
       render_xml $n "$S/mitsuba/shapes-and-lights.xml" 128 128 4096 1024 ;;
+    mitsuba-materials)
+      render_xml $n "$S/mitsuba/materials.xml" 128 128 4096 1024 ;;
     stats) stats ;;
     *) echo "unknown NAME $n" >&2; exit 2 ;;
   esac

@@ -81,7 +81,7 @@ cargo xtask <command>   (the photonflow commands build the release `photonflow` 
                       and their merge (deploy/slurm/), check the result against a one-machine
                       run byte for byte, stop the daemons
   gen-scenes          rewrite the generated OBJ/MTL files of scenes/cornell-spheres
-  fuzz [--seconds N] [--target obj|mtl|scene|photons|exr] [--seed S]
+  fuzz [--seconds N] [--target obj|mtl|ply|ply-ascii|scene|photons|exr] [--seed S]
                       mutate valid files and feed them to each loader for N seconds per target
                       (default 60; `cargo test` runs 3000 cases each): any panic, hang or
                       allocation sized by a header field fails, with the input saved

@@ -742,10 +742,11 @@ impl Settings {
         f.photons = table(toml::Value::try_from(&self.emit))?;
         f.estimate = table(toml::Value::try_from(&self.estimate))?;
         let dir = scene.path.parent().unwrap_or(std::path::Path::new(""));
-        for obj in f.meshes.iter_mut().filter_map(|m| m.obj.as_mut()) {
-            let p = dir.join(&*obj);
+        let files = f.meshes.iter_mut().flat_map(|m| [&mut m.obj, &mut m.ply]);
+        for file in files.flatten() {
+            let p = dir.join(&*file);
             let abs = std::path::absolute(&p).map_err(|e| format!("{}: {e}", p.display()))?;
-            *obj = abs.to_string_lossy().into_owned();
+            *file = abs.to_string_lossy().into_owned();
         }
         Ok(f)
     }

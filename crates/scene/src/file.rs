@@ -15,6 +15,9 @@
 //! scale = 0.025               # a number or [x, y, z]
 //! rotate = [0, 180, 0]        # degrees about x, then y, then z
 //! emission = "ka"             # the course's MTL files keep emission in Ka
+//! [[mesh]]
+//! ply = "bunny.ply"           # or a PLY file, whose faces take a scene-file material
+//! material = "silver"
 //! [[sphere]]
 //! center = [-10.505, 2.2907, -9.2368]
 //! radius = 2.25
@@ -279,6 +282,9 @@ pub struct MeshDesc {
     /// OBJ file, relative to the scene file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub obj: Option<String>,
+    /// PLY file, relative to the scene file, instead of `obj`: its faces take `material`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ply: Option<String>,
     /// A generated shape instead of a file (Mitsuba 3's `rectangle`, `cube`, `disk`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shape: Option<ShapeKind>,
@@ -329,10 +335,10 @@ pub enum ShapeKind {
 impl MeshDesc {
     /// What the mesh is made from, for messages: its file or its shape.
     pub fn source(&self) -> String {
-        match (&self.obj, self.shape) {
-            (Some(o), _) => o.clone(),
-            (None, Some(s)) => format!("{s:?}").to_lowercase(),
-            (None, None) => "no source".into(),
+        match (&self.obj, &self.ply, self.shape) {
+            (Some(o), _, _) | (None, Some(o), _) => o.clone(),
+            (None, None, Some(s)) => format!("{s:?}").to_lowercase(),
+            (None, None, None) => "no source".into(),
         }
     }
 }

@@ -18,6 +18,8 @@ mod materials;
 mod mtl;
 /// OBJ loading and its errors.
 mod obj;
+/// PLY loading and its errors.
+mod ply;
 /// Faces to triangles.
 mod polygon;
 /// The scene file: malformed values, and which of its parts each hash keys.

@@ -8,12 +8,12 @@
 //! Each kind of bad-input failure has cases here: panics, hangs, accepted bad values,
 //! partial output, messages, valid scenes refused and temporary files (a stale file from a
 //! dead process; Ctrl-C itself needs a process: the binary's own test `cli.rs` signals it).
-//! Every loader (OBJ, MTL, scene file, photon file, EXR) and every command's flags have cases
+//! Every loader (OBJ, MTL, PLY, scene file, photon file, EXR) and every command's flags have cases
 //! too (the bench commands only with values refused before any timing starts).
 //!
 //! The table is split by the kind of input at fault, one file each with its own
-//! `bad_input_table` test: the scene file (`scene_file`), its lights (`lights`), OBJ and MTL
-//! files (`obj_mtl`), images (`images`: EXR files, references, environment maps), flags
+//! `bad_input_table` test: the scene file (`scene_file`), its lights (`lights`), OBJ, MTL and
+//! PLY files (`obj_mtl`), images (`images`: EXR files, references, environment maps), flags
 //! (`flags`), photon files (`photon_files`), shard sets and the runs `composite` reads back
 //! (`shards`), and temporary files (`temp_files`). This module holds the good scene they
 //! start from, the helpers several kinds share and the runner.
@@ -44,6 +44,7 @@ const MTL: &str = "newmtl white\nKd 0.5 0.5 0.5\nnewmtl light\nKd 0 0 0\nKe 4 4 
 /// One input file of a case.
 enum Input {
     Text(String),
+    Bytes(Vec<u8>),
     Exr(Image),
     Fifo,
 }
@@ -193,6 +194,7 @@ fn run_table(kind: &str, cases: Vec<Case>) {
             }
             match input {
                 Input::Text(t) => std::fs::write(&p, t).unwrap(),
+                Input::Bytes(b) => std::fs::write(&p, b).unwrap(),
                 Input::Exr(img) => film::write_exr(&p, img).unwrap(),
                 Input::Fifo => {
                     let made = std::process::Command::new("mkfifo").arg(&p).status();

@@ -1,7 +1,9 @@
-//! OBJ and MTL files at fault: malformed colours, faces of 200k and 400k vertices, a mesh
-//! that is a FIFO or scaled past the scene's range, messages naming the line, valid scenes.
+//! OBJ, MTL and PLY files at fault: malformed colours, faces of 200k and 400k vertices, a
+//! mesh that is a FIFO or scaled past the scene's range, messages naming the line, PLY files
+//! cut short, with absurd counts, bad headers and out-of-range indices, valid scenes.
 
 use super::*;
+use tests::ply::{Format, Mesh, write};
 
 /// A polygon face of `n` vertices on a unit circle around the floor's centre (x, z), written
 /// with 7 decimals; `notch` pulls one vertex to the centre (non-convex).
@@ -66,9 +68,21 @@ fn white(
     words: &'static [&'static str],
     check: Option<Check>,
 ) -> Case {
+    let files = files(scene(""), OBJ, &MTL.replace("Kd 0.5 0.5 0.5", lines));
+    info_case(name, files, words, check)
+}
+
+/// A case of `files` run through `info`: refused with `words`, or, with none, loaded and
+/// checked by `check`.
+fn info_case(
+    name: &'static str,
+    files: Vec<(&'static str, Input)>,
+    words: &'static [&'static str],
+    check: Option<Check>,
+) -> Case {
     Case {
         name,
-        files: files(scene(""), OBJ, &MTL.replace("Kd 0.5 0.5 0.5", lines)),
+        files,
         setup: vec![],
         prepare: None,
         args: "info {d}/s.toml",
@@ -437,7 +451,180 @@ fn cases() -> Vec<Case> {
     ]
 }
 
+/// The good scene's second mesh: `p.ply` under the scene-file material `grey`.
+const PLY_MESH: &str = "[[mesh]]\nply = \"p.ply\"\nmaterial = \"grey\"\n\
+    [material.grey]\ntype = \"lambertian\"\nalbedo = [0.5, 0.5, 0.5]\n";
+
+/// A quad just above the floor, as `p.ply` holds it.
+fn ply_quad() -> Mesh {
+    Mesh {
+        positions: vec![
+            [-0.5, 0.01, -0.5],
+            [-0.5, 0.01, 0.5],
+            [0.5, 0.01, 0.5],
+            [0.5, 0.01, -0.5],
+        ],
+        faces: vec![vec![0, 1, 2, 3]],
+        ..Mesh::default()
+    }
+}
+
+/// The quad in little-endian binary, with `edit` applied to its header text.
+fn ply_header_edit(edit: impl Fn(String) -> String) -> Vec<u8> {
+    let b = write(Format::Little, &ply_quad());
+    let end = b.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+    let mut out = edit(String::from_utf8(b[..end].to_vec()).unwrap()).into_bytes();
+    out.extend(&b[end..]);
+    out
+}
+
+/// A case over the good scene and `p.ply` holding `ply`, through `info` (scene text
+/// `toml`): refused with `words` or, with none, loaded and checked by `check`.
+fn ply_case(
+    name: &'static str,
+    toml: &str,
+    ply: Input,
+    words: &'static [&'static str],
+    check: Option<Check>,
+) -> Case {
+    info_case(
+        name,
+        with(files(scene(toml), OBJ, MTL), "p.ply", ply),
+        words,
+        check,
+    )
+}
+
+fn ply_cases() -> Vec<Case> {
+    let bytes = |m: &Mesh| Input::Bytes(write(Format::Little, m));
+    let good = write(Format::Little, &ply_quad());
+    let mut nan = ply_quad();
+    nan.positions[2][1] = f32::NAN;
+    let mut index = ply_quad();
+    index.faces[0][3] = 7;
+    vec![
+        // The OBJ's four triangles and the quad's two.
+        ply_case(
+            "PLY binary",
+            PLY_MESH,
+            bytes(&ply_quad()),
+            &[],
+            triangles(6),
+        ),
+        ply_case(
+            "PLY ascii",
+            PLY_MESH,
+            Input::Bytes(write(Format::Ascii, &ply_quad())),
+            &[],
+            triangles(6),
+        ),
+        ply_case(
+            "PLY binary body cut short",
+            PLY_MESH,
+            Input::Bytes(good[..good.len() - 5].to_vec()),
+            &["p.ply", "the file is cut short", "(mesh 1 of", "s.toml"],
+            None,
+        ),
+        ply_case(
+            "PLY header without end_header",
+            PLY_MESH,
+            text(
+                String::from_utf8_lossy(&good[..good.len() - 4 * 12 - 1 - 16])
+                    .replace("end_header\n", ""),
+            ),
+            &["p.ply", "no `end_header` line", "s.toml"],
+            None,
+        ),
+        ply_case(
+            "PLY face index out of range",
+            PLY_MESH,
+            bytes(&index),
+            &[
+                "p.ply",
+                "face 0: vertex index 7 out of range (the file has 4 vertices)",
+            ],
+            None,
+        ),
+        ply_case(
+            "PLY NaN vertex",
+            PLY_MESH,
+            bytes(&nan),
+            &["p.ply", "vertex 2 is not finite", "s.toml"],
+            None,
+        ),
+        ply_case(
+            "PLY absurd element count",
+            PLY_MESH,
+            Input::Bytes(ply_header_edit(|h| {
+                h.replace("vertex 4", "vertex 4000000000000")
+            })),
+            &[
+                "p.ply",
+                "element `vertex` claims 4000000000000 entries",
+                "bytes follow",
+            ],
+            None,
+        ),
+        ply_case(
+            "PLY unknown format",
+            PLY_MESH,
+            Input::Bytes(ply_header_edit(|h| {
+                h.replace("binary_little_endian", "binary_pdp_endian")
+            })),
+            &["p.ply", "unknown format `binary_pdp_endian`"],
+            None,
+        ),
+        ply_case(
+            "PLY list count of type float",
+            PLY_MESH,
+            Input::Bytes(ply_header_edit(|h| h.replace("list uchar", "list float"))),
+            &[
+                "p.ply",
+                "list `vertex_indices`",
+                "must be an integer type, not `float`",
+            ],
+            None,
+        ),
+        ply_case(
+            "PLY vertex without z",
+            PLY_MESH,
+            Input::Bytes(ply_header_edit(|h| h.replace("property float z\n", ""))),
+            &[
+                "p.ply",
+                "element `vertex` has no property `z` (it has: x, y)",
+            ],
+            None,
+        ),
+        ply_case(
+            "PLY a FIFO",
+            PLY_MESH,
+            Input::Fifo,
+            &["p.ply", "not a regular file", "s.toml"],
+            None,
+        ),
+        ply_case(
+            "PLY mesh without a material",
+            &PLY_MESH.replace("material = \"grey\"\n", ""),
+            bytes(&ply_quad()),
+            &[
+                "s.toml",
+                "mesh 1 (p.ply): a PLY mesh needs `material",
+                "known: ",
+                "grey",
+            ],
+            None,
+        ),
+        ply_case(
+            "PLY mesh with an unknown material",
+            &PLY_MESH.replace("material = \"grey\"", "material = \"gray\""),
+            bytes(&ply_quad()),
+            &["s.toml", "mesh 1 (p.ply): unknown material `gray`", "grey"],
+            None,
+        ),
+    ]
+}
+
 #[test]
 fn bad_input_table() {
-    run_table("obj-mtl", cases());
+    run_table("obj-mtl", cases().into_iter().chain(ply_cases()).collect());
 }

@@ -54,6 +54,7 @@ pub(super) fn scene_hashes(file: &SceneFile, files: u64, text: &str) -> (u64, u6
             .iter()
             .map(|m| MeshDesc {
                 obj: m.obj.as_ref().map(|_| String::new()),
+                ply: m.ply.as_ref().map(|_| String::new()),
                 ..m.clone()
             })
             .collect();

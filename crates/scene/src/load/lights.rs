@@ -84,7 +84,11 @@ impl Builder<'_> {
         let at_infinity = !infinite.is_empty();
         others.extend(infinite);
         if lights.is_empty() && others.is_empty() {
-            let hint = if file.meshes.iter().any(|m| m.emission == EmissionSource::Ke) {
+            let hint = if file
+                .meshes
+                .iter()
+                .any(|m| m.obj.is_some() && m.emission == EmissionSource::Ke)
+            {
                 " (hint: the course's MTL files keep emission in Ka: set emission = \"ka\" on the mesh)"
             } else {
                 ""

@@ -1,8 +1,10 @@
 //! Loading: a scene file and every file it names into a [`Scene`]. One room per concern:
-//! `obj.rs` (OBJ meshes), `mtl.rs` (the MTL table), `materials.rs` (scene-file materials,
-//! textures, validation), `lights.rs` (emissive triangles and the scene file's lights),
-//! `transform.rs` (the one transform helper), `hash.rs` (cache keys). This file holds the
-//! entry points and the [`Builder`] they share, and assembles the scene.
+//! `obj.rs` (OBJ meshes), `ply.rs` (PLY meshes), `faces.rs` (what both share: their
+//! polygons checked, transformed, triangulated and appended), `mtl.rs` (the MTL table),
+//! `materials.rs` (scene-file materials, textures, validation), `lights.rs` (emissive
+//! triangles and the scene file's lights), `transform.rs` (the one transform helper),
+//! `hash.rs` (cache keys). This file holds the entry points and the [`Builder`] they share,
+//! and assembles the scene.
 
 // A decoder of untrusted bytes: no input may reach a panic, so the lints that find the ways
 // to one (unwrap, expect, indexing, explicit panics) are errors here and in every room below;
@@ -18,11 +20,13 @@
     )
 )]
 
+mod faces;
 mod hash;
 mod lights;
 mod materials;
 mod mtl;
 mod obj;
+pub(crate) mod ply;
 mod shapes;
 mod transform;
 

@@ -1,16 +1,17 @@
-//! OBJ meshes: the file read whole (its MTL files through `mtl.rs`), each face
-//! triangulated here (`polygon.rs`), vertices and normals put through the mesh's transform,
-//! texture coordinates kept, every problem named with its file and line.
+//! OBJ meshes: the file read whole (its MTL files through `mtl.rs`), each model's faces
+//! under its material handed to `faces.rs` (triangulated, transformed, appended), every
+//! problem named with its file and line. `load_mesh`, here, sends each mesh to its reader:
+//! this file, `ply.rs` or `shapes.rs`.
 
 use super::Builder;
+use super::faces::{FileErr, Polygons};
 use super::materials::{MTL_KEYS, Source};
 use super::mtl::{convert_mtl, prescan};
+use super::read_regular;
 use super::transform::transform;
-use super::{MAX_COORD, read_regular};
 use crate::error::SceneError;
-use crate::file::{EmissionSource, MeshDesc, NormalMode, TfReading};
-use geom::{TriMesh, smooth_vertex_normals};
-use glam::{DMat3, DMat4, DVec3, Vec2};
+use crate::file::{EmissionSource, MeshDesc, TfReading};
+use glam::DMat4;
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::io::BufReader;
@@ -34,7 +35,7 @@ enum Faces<'m> {
 }
 
 /// Makes a problem with the OBJ file into its error (naming the file and the scene).
-type ObjErr<'e> = &'e dyn Fn(String) -> SceneError;
+type ObjErr<'e> = FileErr<'e>;
 
 impl Builder<'_> {
     /// Mesh `index` of the scene file: read (or generated), its materials added, its faces
@@ -48,12 +49,23 @@ impl Builder<'_> {
                 desc.source()
             ))
         })?;
-        match (&desc.obj, desc.shape) {
-            (Some(obj), None) => self.load_obj(index, obj, desc, xf, own),
-            (None, Some(kind)) => self.load_shape(index, kind, desc, xf, own),
+        match (&desc.obj, &desc.ply, desc.shape) {
+            (Some(obj), None, None) => self.load_obj(index, obj, desc, xf, own),
+            (None, Some(ply), None) => {
+                // A PLY file has no materials: the scene file gives its one.
+                let Some(own) = own else {
+                    return Err(self.err(format!(
+                        "mesh {index} ({ply}): a PLY mesh needs `material = \"name\"`: the file \
+                         has no materials (known: {})",
+                        self.names.join(", ")
+                    )));
+                };
+                self.load_ply(index, desc, ply, xf, own)
+            }
+            (None, None, Some(kind)) => self.load_shape(index, kind, desc, xf, own),
             _ => Err(self.err(format!(
-                "mesh {index}: give exactly one of `obj` (a file) and `shape` (rectangle, \
-                 cube, disk)"
+                "mesh {index}: give exactly one of `obj` or `ply` (a file) and `shape` \
+                 (rectangle, cube, disk)"
             ))),
         }
     }
@@ -265,8 +277,8 @@ impl Builder<'_> {
             .collect()
     }
 
-    /// One model (an `o`/`g` group) of the OBJ, its faces triangulated and transformed,
-    /// appended to the scene's mesh.
+    /// One model (an `o`/`g` group) of the OBJ, its faces appended to the scene's mesh
+    /// (`faces.rs`) under its material.
     fn append_model(
         &mut self,
         model: &tobj::Model,
@@ -276,52 +288,11 @@ impl Builder<'_> {
         obj_path: &Path,
         oerr: ObjErr,
     ) -> Result<(), SceneError> {
-        let nxf = DMat3::from_mat4(xf).inverse().transpose();
         let m = &model.mesh;
         if m.indices.is_empty() {
             return Ok(());
         }
-        let nv = m.positions.len() / 3;
-        let mut part = TriMesh::default();
-        for (v, &[x, y, z]) in m.positions.as_chunks::<3>().0.iter().enumerate() {
-            let p = DVec3::new(x as f64, y as f64, z as f64);
-            if !p.is_finite() {
-                return Err(oerr(format!(
-                    "object `{}`: vertex {} is not finite ({:?})",
-                    model.name,
-                    v + 1,
-                    p.to_array()
-                )));
-            }
-            let q = xf.transform_point3(p);
-            if !q.is_finite() || q.abs().max_element() > MAX_COORD {
-                return Err(oerr(format!(
-                    "object `{}`: vertex {} lies at {:?} after the mesh's transform, beyond \
-                     the {MAX_COORD:e} scene units photonflow can trace: check the scale",
-                    model.name,
-                    v + 1,
-                    q.to_array()
-                )));
-            }
-            part.positions.push(q.as_vec3());
-        }
-        let use_file_normals =
-            matches!(desc.normals, NormalMode::Auto) && m.normals.len() == 3 * nv;
-        if use_file_normals {
-            for (v, &[x, y, z]) in m.normals.as_chunks::<3>().0.iter().enumerate() {
-                let n = DVec3::new(x as f64, y as f64, z as f64);
-                let n = (nxf * n).normalize_or_zero();
-                if !n.is_finite() || n == DVec3::ZERO {
-                    return Err(oerr(format!(
-                        "object `{}`: normal {} is zero or not finite",
-                        model.name,
-                        v + 1
-                    )));
-                }
-                part.normals.push(n.as_vec3());
-            }
-        }
-        let mat = match (faces, m.material_id) {
+        let material = match (faces, m.material_id) {
             (Faces::Own(id), _) => *id,
             (Faces::Mtl(ids), Some(i)) => match ids.get(i) {
                 Some(&id) => id,
@@ -339,67 +310,19 @@ impl Builder<'_> {
                 )));
             }
         };
-        if m.indices.iter().any(|&i| i as usize >= nv) {
-            return Err(oerr(format!(
-                "object `{}`: face index out of range",
-                model.name
-            )));
-        }
-        // All triangles (no arities) or one arity per face.
-        let arities: Box<dyn Iterator<Item = usize>> = if m.face_arities.is_empty() {
-            Box::new(std::iter::repeat_n(3, m.indices.len() / 3))
-        } else {
-            Box::new(m.face_arities.iter().map(|&a| a as usize))
+        let label = format!("object `{}`", model.name);
+        let polygons = Polygons {
+            label: &label,
+            first: 1,
+            uv_keys: "`vt`",
+            positions: &m.positions,
+            normals: &m.normals,
+            texcoords: &m.texcoords,
+            indices: &m.indices,
+            arities: &m.face_arities,
+            material,
         };
-        let mut start = 0usize;
-        let mut triangles = Vec::new();
-        for (f, n) in arities.enumerate() {
-            let Some(face) = m.indices.get(start..start.saturating_add(n)) else {
-                return Err(oerr(format!(
-                    "object `{}`: face {} runs past the index list",
-                    model.name,
-                    f + 1
-                )));
-            };
-            start += n;
-            crate::polygon::triangulate(face, &part.positions, &mut triangles)
-                .map_err(|p| oerr(format!("object `{}`, face {}: {p}", model.name, f + 1)))?;
-        }
-        if m.texcoords.len() == 2 * nv {
-            for (v, &[u, w]) in m.texcoords.as_chunks::<2>().0.iter().enumerate() {
-                if !(u.is_finite() && w.is_finite()) {
-                    return Err(oerr(format!(
-                        "object `{}`: texture coordinate {} is not finite",
-                        model.name,
-                        v + 1
-                    )));
-                }
-                part.texcoords.push(Vec2::new(u, w));
-            }
-        } else if self
-            .albedo_maps
-            .get(mat as usize)
-            .is_some_and(Option::is_some)
-        {
-            // Mitsuba 3 reads a mesh without texture coordinates at its barycentrics.
-            self.warnings.push(format!(
-                "{}: object `{}` has no texture coordinates (`vt`) for the texture of \
-                 material `{}`: read at each triangle's barycentric coordinates",
-                obj_path.display(),
-                model.name,
-                self.names.get(mat as usize).map_or("?", String::as_str)
-            ));
-        }
-        part.materials = vec![mat; triangles.len()];
-        part.indices = triangles;
-        if desc.normals == NormalMode::Smooth {
-            part.normals = smooth_vertex_normals(&part.positions, &part.indices);
-        }
-        if desc.flip_normals {
-            super::shapes::flip(&mut part);
-        }
-        self.mesh.append(&part);
-        Ok(())
+        self.append_polygons(&polygons, desc, xf, obj_path, oerr)
     }
 }
 

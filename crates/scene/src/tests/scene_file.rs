@@ -64,3 +64,34 @@ fn malformed_toml_values_are_named_with_their_line() {
         "camera",
     );
 }
+
+/// The hashes of a scene of the tree, pinned: a change to the scene file's schema (a new
+/// optional key, `obj` made optional beside `ply`) must not move the caches and image
+/// metadata of scenes that do not use it.
+#[test]
+fn hashes_of_existing_scenes_are_pinned() {
+    for (rel, want) in [
+        (
+            "cornell-spheres/analytic.toml",
+            [
+                0x4a13094c041d42fc,
+                0x4a8cf312b717d783,
+                0x0a6652980b9e8d9f,
+                0x4d60ebdc3ac04636,
+            ],
+        ),
+        (
+            "cornell-glossy/glossy-floor.toml",
+            [
+                0x0d2a5cb4a6bb47f5,
+                0x799170baead5d71c,
+                0x98780647dfbce24e,
+                0x4ad69ffc3a8645d1,
+            ],
+        ),
+    ] {
+        let s = load(rel);
+        let got = [s.photon_hash, s.image_hash, s.view_hash, s.content_hash];
+        assert_eq!(got, want, "{rel}: hashes moved: {got:#018x?}");
+    }
+}

@@ -328,7 +328,10 @@ impl<'a> Converter<'a> {
             "cube" => mesh.shape = Some(ShapeKind::Cube),
             "disk" => mesh.shape = Some(ShapeKind::Disk),
             "ply" => {
-                return Err(p.err("PLY meshes: not read by this build of photonflow"));
+                let f = p
+                    .string("filename")?
+                    .ok_or_else(|| p.err("needs `filename`"))?;
+                mesh.ply = Some(self.path_of(e, f));
             }
             _ => {
                 return Err(p.err(
