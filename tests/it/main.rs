@@ -5,6 +5,8 @@
 //!   their lights, OBJ and MTL, images, flags, photon files, shards and runs read back, temp
 //!   files), each run through the command line in process: exit code and a one-line message
 //!   naming the file and the problem, or the output a valid input must give.
+//! - `convert`: a Mitsuba XML scene converted to a scene file elsewhere is the same scene
+//!   (its image, bit for bit).
 //! - `cornell`: ray casting on the worksheet scene as loaded from `scenes/` (BVH = brute force,
 //!   the light under the ceiling is reachable, camera rays behave).
 //! - `evidence`: bias^2 and variance apart from independent runs: zero bias for the path
@@ -59,6 +61,7 @@
 static ALLOC: tests::alloc::Tracking = tests::alloc::Tracking;
 
 mod bad_input;
+mod convert;
 mod cornell;
 mod evidence;
 mod fuzz;

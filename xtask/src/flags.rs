@@ -45,6 +45,8 @@ cargo xtask <command>   (the photonflow commands build the release `photonflow` 
                       RMSE, relative MSE, mean absolute error and FLIP of A against reference B;
                       B2, the reference's second independent half, takes its noise out
   info SCENE          load a scene and print what it holds
+  convert SCENE.xml --out SCENE.toml
+                      the scene file a Mitsuba 3 XML scene means (files referenced)
   bench ...           updates docs/benchmarks.md: each benchmark builds with the release-lto
                       profile, echoes its output and records it (command, date, machine) as
                       its own section, replacing that section's previous run
@@ -114,6 +116,7 @@ pub struct Bench {
 /// The commands passed to the photonflow binary under their own name.
 pub const FORWARDED: &[&str] = &[
     "info",
+    "convert",
     "render",
     "compare",
     "composite",

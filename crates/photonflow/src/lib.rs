@@ -423,8 +423,8 @@ fn convert(xml: &Path, out: &Path, d: &Defines) -> Result<(), String> {
         Ok(())
     };
     for m in &mut file.meshes {
-        if let Some(o) = &mut m.obj {
-            moved(o)?;
+        for f in [&mut m.obj, &mut m.ply].into_iter().flatten() {
+            moved(f)?;
         }
     }
     for m in file.materials.values_mut() {
@@ -433,6 +433,14 @@ fn convert(xml: &Path, out: &Path, d: &Defines) -> Result<(), String> {
             ..
         }
         | scene::MaterialDesc::Glossy {
+            texture: Some(scene::TextureDesc::File(t)),
+            ..
+        }
+        | scene::MaterialDesc::Plastic {
+            texture: Some(scene::TextureDesc::File(t)),
+            ..
+        }
+        | scene::MaterialDesc::RoughPlastic {
             texture: Some(scene::TextureDesc::File(t)),
             ..
         } = m

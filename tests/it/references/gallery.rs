@@ -9,7 +9,8 @@ use super::{
 use crate::kit::{PIXEL_POINTS, scenes_dir};
 use scene::{LightDesc, Method, Scene, SceneFile};
 
-/// `scenes/mitsuba/NAME.xml` at 128 x 128 (its `$width` and `$height`), seed `seed`.
+/// The gallery's scene `name` (in `scenes/mitsuba/`) at 128 x 128 (its `$width` and
+/// `$height`), seed `seed`.
 fn gallery(name: &str, seed: u64, edit: impl FnOnce(&mut SceneFile)) -> Scene {
     let size = [("width", RES), ("height", RES)].map(|(k, v)| (k.to_string(), v.to_string()));
     Scene::load_defined(

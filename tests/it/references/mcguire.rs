@@ -166,7 +166,7 @@ fn mcguire_original_matches_mitsuba() {
 // ---------------------------------------------------------------------------------------------
 // The Sphere, Water, Mirror and Glossy boxes.
 
-/// `scenes/mcguire/NAME.toml` at 128 x 128.
+/// McGuire's box `name` (its scene file in `scenes/mcguire/`) at 128 x 128.
 fn mcguire(name: &str, seed: u64, edit: impl FnOnce(&mut SceneFile)) -> Scene {
     scene_at(&format!("mcguire/{name}.toml"), RES, seed, edit)
 }

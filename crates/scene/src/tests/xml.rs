@@ -70,7 +70,7 @@ fn transforms_place_things_where_mitsuba_does() {
     assert_eq!((*cutoff_angle, *beam_width), (20.0, None));
 }
 
-/// `scenes/mitsuba/worksheet.xml` is the worksheet scene (`cornell-spheres/analytic.toml`)
+/// `scenes/mitsuba/worksheet.xml` is the worksheet scene (`scenes/cornell-spheres/analytic.toml`)
 /// written independently in Mitsuba's terms: its box in millimetres placed by a transform, its
 /// lamp a rectangle, its materials by `<ref>` from an included file. Both load to the same
 /// camera, triangles, spheres, materials and light.
