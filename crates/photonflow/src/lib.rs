@@ -418,43 +418,9 @@ fn convert(xml: &Path, out: &Path, d: &Defines) -> Result<(), String> {
     let mut file = x.file;
     let from = xml.parent().unwrap_or(Path::new(""));
     let to = out.parent().unwrap_or(Path::new(""));
-    let moved = |p: &mut String| -> Result<(), String> {
-        *p = paths::relative_to(&from.join(&*p), to)?;
-        Ok(())
-    };
-    for m in &mut file.meshes {
-        for f in [&mut m.obj, &mut m.ply].into_iter().flatten() {
-            moved(f)?;
-        }
-    }
-    for m in file.materials.values_mut() {
-        if let scene::MaterialDesc::Lambertian {
-            texture: Some(scene::TextureDesc::File(t)),
-            ..
-        }
-        | scene::MaterialDesc::Glossy {
-            texture: Some(scene::TextureDesc::File(t)),
-            ..
-        }
-        | scene::MaterialDesc::Plastic {
-            texture: Some(scene::TextureDesc::File(t)),
-            ..
-        }
-        | scene::MaterialDesc::RoughPlastic {
-            texture: Some(scene::TextureDesc::File(t)),
-            ..
-        } = m
-        {
-            moved(t)?;
-        }
-    }
-    for l in &mut file.lights {
-        if let scene::LightDesc::Environment {
-            filename: Some(f), ..
-        } = l
-        {
-            moved(f)?;
-        }
+    // Every file name, relative to the new file.
+    for name in file.file_names_mut() {
+        *name = paths::relative_to(&from.join(&*name), to)?;
     }
     let text = toml::to_string(&file).map_err(|e| format!("internal error: {e}"))?;
     let text = format!(

@@ -742,11 +742,10 @@ impl Settings {
         f.photons = table(toml::Value::try_from(&self.emit))?;
         f.estimate = table(toml::Value::try_from(&self.estimate))?;
         let dir = scene.path.parent().unwrap_or(std::path::Path::new(""));
-        let files = f.meshes.iter_mut().flat_map(|m| [&mut m.obj, &mut m.ply]);
-        for file in files.flatten() {
-            let p = dir.join(&*file);
+        for name in f.file_names_mut() {
+            let p = dir.join(&*name);
             let abs = std::path::absolute(&p).map_err(|e| format!("{}: {e}", p.display()))?;
-            *file = abs.to_string_lossy().into_owned();
+            *name = abs.to_string_lossy().into_owned();
         }
         Ok(f)
     }

@@ -95,6 +95,48 @@ fn default_up() -> [f32; 3] {
     [0.0, 1.0, 0.0]
 }
 
+impl SceneFile {
+    /// Every file name the scene file holds, relative to it unless absolute: meshes (`obj`,
+    /// `ply`), image textures, environment maps. For moving a scene file (`convert`, a run's
+    /// resolved `scene.toml`) and for cache keys, which read the files' contents instead.
+    pub fn file_names_mut(&mut self) -> Vec<&mut String> {
+        let mut out: Vec<&mut String> = Vec::new();
+        for m in &mut self.meshes {
+            out.extend([&mut m.obj, &mut m.ply].into_iter().flatten());
+        }
+        for m in self.materials.values_mut() {
+            if let MaterialDesc::Lambertian {
+                texture: Some(TextureDesc::File(t)),
+                ..
+            }
+            | MaterialDesc::Glossy {
+                texture: Some(TextureDesc::File(t)),
+                ..
+            }
+            | MaterialDesc::Plastic {
+                texture: Some(TextureDesc::File(t)),
+                ..
+            }
+            | MaterialDesc::RoughPlastic {
+                texture: Some(TextureDesc::File(t)),
+                ..
+            } = m
+            {
+                out.push(t);
+            }
+        }
+        for l in &mut self.lights {
+            if let LightDesc::Environment {
+                filename: Some(f), ..
+            } = l
+            {
+                out.push(f);
+            }
+        }
+        out
+    }
+}
+
 /// Eye-pass settings. Every field has a default so a scene file may leave it out.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]

@@ -47,21 +47,16 @@ pub(super) fn scene_hashes(file: &SceneFile, files: u64, text: &str) -> (u64, u6
             camera: Option<&'a CameraDesc>,
             render: Option<&'a RenderSettings>,
         }
-        // Mesh files count by content (`files`), not by the path that names them, so a
-        // resolved scene file with absolute paths keeps its caches.
-        let meshes: Vec<MeshDesc> = f
-            .meshes
-            .iter()
-            .map(|m| MeshDesc {
-                obj: m.obj.as_ref().map(|_| String::new()),
-                ply: m.ply.as_ref().map(|_| String::new()),
-                ..m.clone()
-            })
-            .collect();
+        // Files count by content (`files`), not by the path that names them, so a resolved
+        // scene file with absolute paths keeps its caches.
+        let mut f = f.clone();
+        for name in f.file_names_mut() {
+            name.clear();
+        }
         toml::to_string(&Inputs {
             files,
             seed: if seed { f.seed } else { 0 },
-            meshes: &meshes,
+            meshes: &f.meshes,
             spheres: &f.spheres,
             materials: &f.materials,
             lights: &f.lights,
