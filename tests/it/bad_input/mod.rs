@@ -117,8 +117,13 @@ fn present(rel: &'static str, holds: &'static str) -> Option<Check> {
 
 /// The case's `s.toml` loads, with a warning that holds every one of `words`.
 fn warns(words: &'static [&'static str]) -> Option<Check> {
+    warns_in("s.toml", words)
+}
+
+/// The case's scene `file` loads, with a warning that holds every one of `words`.
+fn warns_in(file: &'static str, words: &'static [&'static str]) -> Option<Check> {
     Some(Box::new(move |d: &Path| {
-        let s = scene::Scene::load(d.join("s.toml")).unwrap_or_else(|e| panic!("{e}"));
+        let s = scene::Scene::load(d.join(file)).unwrap_or_else(|e| panic!("{e}"));
         assert!(
             s.warnings
                 .iter()

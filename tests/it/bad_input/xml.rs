@@ -45,20 +45,6 @@ fn refused(name: &'static str, extra: &str, words: &'static [&'static str]) -> C
     }
 }
 
-/// The scene `s.xml` loads, with a warning holding every one of `words`.
-fn xml_warns(words: &'static [&'static str]) -> Option<Check> {
-    Some(Box::new(move |d: &Path| {
-        let s = scene::Scene::load(d.join("s.xml")).unwrap_or_else(|e| panic!("{e}"));
-        assert!(
-            s.warnings
-                .iter()
-                .any(|w| words.iter().all(|x| w.contains(x))),
-            "no warning holds {words:?}: {:?}",
-            s.warnings
-        );
-    }))
-}
-
 fn warned(name: &'static str, extra: &str, words: &'static [&'static str]) -> Case {
     Case {
         name,
@@ -68,7 +54,7 @@ fn warned(name: &'static str, extra: &str, words: &'static [&'static str]) -> Ca
         args: "info {d}/s.xml",
         code: 0,
         words: &[],
-        check: xml_warns(words),
+        check: warns_in("s.xml", words),
     }
 }
 
@@ -283,11 +269,14 @@ fn cases() -> Vec<Case> {
             args: "info {d}/s.xml",
             code: 0,
             words: &[],
-            check: xml_warns(&[
-                "s.xml: line 10",
-                "<rfilter type=\"gaussian\">",
-                "drawn with a box",
-            ]),
+            check: warns_in(
+                "s.xml",
+                &[
+                    "s.xml: line 10",
+                    "<rfilter type=\"gaussian\">",
+                    "drawn with a box",
+                ],
+            ),
         },
         warned(
             "a Beckmann surface",
