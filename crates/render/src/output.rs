@@ -138,13 +138,38 @@ pub fn write(
     let json_text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
 
     let staged = stage(o.out)?;
+    // Errors name the files by the place they were going to (the staging directory is
+    // removed).
+    write_files(
+        &staged,
+        &image,
+        &tone,
+        r,
+        &snapshot_images,
+        &scene_text,
+        &json_text,
+    )
+    .map_err(|e| staged.named(e))?;
+    staged.publish()?;
+    Ok((image, metrics))
+}
+
+fn write_files(
+    staged: &Staged,
+    image: &Image,
+    tone: &ToneMap,
+    r: &Rendered,
+    snapshot_images: &[(String, Image)],
+    scene_text: &str,
+    json_text: &str,
+) -> Result<(), String> {
     let out = staged.path();
     let mkdir = |d: &Path| {
         std::fs::create_dir(d).map_err(|e| format!("{}: cannot create: {e}", d.display()))
     };
     mkdir(&out.join("layers"))?;
-    film::write_exr(out.join("image.exr"), &image).map_err(|e| e.to_string())?;
-    film::write_png(out.join("image.png"), &image, &tone).map_err(|e| e.to_string())?;
+    film::write_exr(out.join("image.exr"), image).map_err(|e| e.to_string())?;
+    film::write_png(out.join("image.png"), image, tone).map_err(|e| e.to_string())?;
     for l in &r.layers {
         film::write_exr(out.join("layers").join(format!("{}.exr", l.name)), &l.image)
             .map_err(|e| e.to_string())?;
@@ -152,7 +177,7 @@ pub fn write(
     if !snapshot_images.is_empty() {
         mkdir(&out.join("snapshots"))?;
     }
-    for (file, img) in &snapshot_images {
+    for (file, img) in snapshot_images {
         film::write_exr(out.join(file), img).map_err(|e| e.to_string())?;
     }
     let w = |name: &str, bytes: &[u8]| {
@@ -163,8 +188,7 @@ pub fn write(
         w("plan.txt", plan.to_string().as_bytes())?;
     }
     w("image.json", json_text.as_bytes())?;
-    staged.publish()?;
-    Ok((image, metrics))
+    Ok(())
 }
 
 /// What a run directory holds (and all it may hold to be replaced by another run).
@@ -238,6 +262,14 @@ impl Staged {
     /// Where to write the directory's files.
     pub fn path(&self) -> &Path {
         self.tmp.path()
+    }
+
+    /// `e` with the staging directory's path replaced by the run directory's, for a message.
+    pub fn named(&self, e: String) -> String {
+        e.replace(
+            &self.tmp.path().display().to_string(),
+            &self.out.display().to_string(),
+        )
     }
 
     /// Renames it into place, replacing the run directory there.

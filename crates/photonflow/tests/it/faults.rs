@@ -309,3 +309,194 @@ fn kill_9_at_any_instant_leaves_whole_outputs_and_a_good_cache() {
     println!("kill -9 harness: {tried} instants tried, {killed} killed before the end");
     assert!(tried >= 50);
 }
+
+/// A tmpfs mounted for a test, unmounted when dropped (a failed assertion included).
+struct Mount(PathBuf);
+
+impl Drop for Mount {
+    fn drop(&mut self) {
+        let _ = Command::new("umount").arg(&self.0).status();
+    }
+}
+
+/// Mounts a tmpfs with `options` at `dir` (made if missing); `None`, with the reason printed,
+/// where this machine cannot, unless `PHOTONFLOW_REQUIRE_FAULTS` is set (CI), which fails.
+fn tmpfs(dir: &Path, options: &str) -> Option<Mount> {
+    std::fs::create_dir_all(dir).unwrap();
+    let why = match Command::new("mount")
+        .args(["-t", "tmpfs", "-o", options, "tmpfs"])
+        .arg(dir)
+        .output()
+    {
+        Ok(o) if o.status.success() => return Some(Mount(dir.to_path_buf())),
+        Ok(o) => String::from_utf8_lossy(&o.stderr).trim().to_string(),
+        Err(e) => format!("cannot run mount: {e}"),
+    };
+    let why = format!(
+        "cannot mount a tmpfs ({options}) at {}: {why}",
+        dir.display()
+    );
+    assert!(
+        std::env::var_os("PHOTONFLOW_REQUIRE_FAULTS").is_none(),
+        "PHOTONFLOW_REQUIRE_FAULTS is set: {why}"
+    );
+    println!("skipped: {why}");
+    None
+}
+
+/// The one `error:` line of a failed run's stderr (progress lines aside).
+fn error_line(o: &std::process::Output, what: &str) -> String {
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{what}: {e}");
+    assert!(!e.contains("panicked"), "{what}: {e}");
+    let errors: Vec<&str> = e.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(errors.len(), 1, "{what}: {e}");
+    errors[0].to_string()
+}
+
+/// Output and cache on a 2 MB filesystem: the photon files fit, the run directory (SPPM's
+/// snapshots at 200 x 200) fills it. One line names the file and the OS error, nothing of the
+/// run directory is left, and the cache's whole sets serve the next run.
+#[test]
+fn a_full_disk_leaves_no_partial_output_and_a_good_cache() {
+    let work = Work::new("full");
+    let small = scene(&work.0, 200);
+    let Some(m) = tmpfs(&work.0.join("disk"), "size=2m") else {
+        return;
+    };
+    let cache = m.0.join("cache");
+    let out = m.0.join("run");
+    let path = |p: &Path| p.to_str().unwrap().to_string();
+    let args = |out: &Path| -> Vec<String> {
+        [
+            "render",
+            &small,
+            "--method",
+            "sppm",
+            "--passes",
+            "4",
+            "--photons",
+            "20000",
+            "--threads",
+            "1",
+            "--cache",
+            &path(&cache),
+            "--out",
+            &path(out),
+        ]
+        .iter()
+        .map(|a| a.to_string())
+        .collect()
+    };
+    // The photon sets first (about 1.5 MB), then the run that fills the disk.
+    let trace = [
+        "trace",
+        &small,
+        "--photons",
+        "20000",
+        "--threads",
+        "1",
+        "--cache",
+        &path(&cache),
+    ];
+    let o = photonflow(&trace.map(String::from));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = photonflow(&args(&out));
+    let line = error_line(&o, "a full disk");
+    assert!(
+        line.contains(&path(&out)) && line.contains("No space left on device"),
+        "{line}"
+    );
+    assert!(!line.contains(".tmp-"), "names a staging path: {line}");
+    assert!(!out.exists(), "a partial run directory");
+    let left: Vec<String> = tree(&m.0).into_keys().filter(|n| is_temp(n)).collect();
+    assert!(left.is_empty(), "left {left:?}");
+    let sets: Vec<String> = tree(&cache)
+        .into_keys()
+        .filter(|n| n.ends_with(".photons"))
+        .collect();
+    assert_eq!(sets.len(), 2, "{sets:?}");
+    for name in &sets {
+        let r = store::StoreReader::open(&cache.join(name)).unwrap();
+        r.read_all().unwrap();
+    }
+    // The next run, with room for its output, estimates from the cache alone.
+    let elsewhere = work.0.join("run");
+    let mut a = args(&elsewhere);
+    a[0] = "estimate".into();
+    a[2..5].clone_from_slice(&["--method".into(), "final-gather".into(), "--spp".into()]);
+    a[5] = "1".into();
+    let o = photonflow(&a);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{e}");
+    assert!(elsewhere.join("image.json").is_file());
+}
+
+/// An output place that cannot be written (a read-only filesystem: root ignores modes): one
+/// line naming the path and the OS error, nothing written; a run directory already there
+/// stays whole, and the photon cache elsewhere serves the next run.
+#[test]
+fn a_read_only_output_place_is_one_line_and_keeps_what_is_there() {
+    let work = Work::new("readonly");
+    let small = scene(&work.0, 16);
+    let cache = work.0.join("cache");
+    let place = work.0.join("ro");
+    let Some(m) = tmpfs(&place, "size=1m") else {
+        return;
+    };
+    let path = |p: &Path| p.to_str().unwrap().to_string();
+    let out = m.0.join("run");
+    let args = |method: &str| -> Vec<String> {
+        [
+            "render",
+            &small,
+            "--method",
+            method,
+            "--photons",
+            "5000",
+            "--threads",
+            "1",
+            "--cache",
+            &path(&cache),
+            "--out",
+            &path(&out),
+        ]
+        .iter()
+        .map(|a| a.to_string())
+        .collect()
+    };
+    let o = photonflow(&args("sppm"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let before = tree(&out);
+    let o = Command::new("mount")
+        .args(["-o", "remount,ro"])
+        .arg(&m.0)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for (what, method) in [("over a run", "final-gather"), ("beside it", "sppm")] {
+        let target = if what == "beside it" {
+            m.0.join("new")
+        } else {
+            out.clone()
+        };
+        let mut a = args(method);
+        *a.last_mut().unwrap() = path(&target);
+        let o = photonflow(&a);
+        let line = error_line(&o, what);
+        assert!(
+            line.contains(&path(&target)) && line.contains("Read-only file system"),
+            "{what}: {line}"
+        );
+    }
+    assert!(tree(&out) == before, "the run directory there changed");
+    assert!(!m.0.join("new").exists());
+    let o = photonflow(&{
+        let mut a = args("final-gather");
+        *a.last_mut().unwrap() = path(&work.0.join("run"));
+        a
+    });
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{e}");
+    assert!(!e.contains("photons: traced"), "traced again: {e}");
+}
