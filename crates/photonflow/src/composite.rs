@@ -24,6 +24,7 @@ pub fn run(inputs: &[PathBuf], out: &Path, exposure: f32) -> Result<(), String> 
         dirs.push(run_dir(p)?);
     }
     refuse_overwriting_an_input(&dirs, out)?;
+    render::output::check_out(out)?;
     let mut loaded = Vec::with_capacity(dirs.len());
     for d in &dirs {
         loaded.push(load(d)?);
@@ -127,8 +128,7 @@ fn load(dir: &Path) -> Result<::composite::Input, String> {
     })
 }
 
-/// Writes the layers first and `image.json` last, so a directory with an `image.json`
-/// holds a complete result.
+/// Writes the directory whole in a staging directory and renames it into place.
 fn write(c: &::composite::Composite, out: &Path, exposure: f32) -> Result<(), String> {
     let tone = ToneMap {
         exposure,
@@ -138,19 +138,17 @@ fn write(c: &::composite::Composite, out: &Path, exposure: f32) -> Result<(), St
     json["tone_map"] = serde_json::json!({ "gamma": tone.gamma, "exposure": tone.exposure });
     let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
 
-    std::fs::create_dir_all(out.join("layers"))
-        .map_err(|e| format!("{}: cannot create output directory: {e}", out.display()))?;
-    // A run killed mid-write (kill -9) left its temp files: no run will finish or read them.
-    for dir in [out.to_path_buf(), out.join("layers")] {
-        for stale in temps::remove_stale(&dir) {
-            eprintln!("{stale}");
-        }
-    }
+    let staged = render::output::stage(out)?;
+    let dir = staged.path();
+    let layers = dir.join("layers");
+    std::fs::create_dir(&layers)
+        .map_err(|e| format!("{}: cannot create: {e}", layers.display()))?;
     for l in &c.layers {
-        film::write_exr(out.join("layers").join(format!("{}.exr", l.name)), &l.image)
+        film::write_exr(layers.join(format!("{}.exr", l.name)), &l.image)
             .map_err(|e| e.to_string())?;
     }
-    film::write_exr(out.join("image.exr"), &c.image).map_err(|e| e.to_string())?;
-    film::write_png(out.join("image.png"), &c.image, &tone).map_err(|e| e.to_string())?;
-    film::write_atomic(&out.join("image.json"), text.as_bytes()).map_err(|e| e.to_string())
+    film::write_exr(dir.join("image.exr"), &c.image).map_err(|e| e.to_string())?;
+    film::write_png(dir.join("image.png"), &c.image, &tone).map_err(|e| e.to_string())?;
+    film::write_atomic(&dir.join("image.json"), text.as_bytes()).map_err(|e| e.to_string())?;
+    staged.publish()
 }

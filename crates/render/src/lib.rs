@@ -87,6 +87,7 @@ pub fn render(scene: &Scene, req: &RenderRequest) -> Result<RenderSummary, Strin
     if !req.exposure.is_finite() {
         return Err(format!("--exposure {} must be finite", req.exposure));
     }
+    output::check_out(&out)?;
     // The bar starts with the eye pass's first finished tile, so tracing and loading photons
     // (which report on their own) neither share the terminal line nor its rate.
     let bar = std::sync::OnceLock::new();

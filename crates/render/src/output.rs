@@ -2,7 +2,9 @@
 //! `image.json` (settings, counts, layer classes, timings, errors against a reference) and
 //! `scene.toml`, the resolved scene file that reproduces the run bit for bit. Everything that
 //! can fail (the reference, the settings' serialisation) is checked before the first byte is
-//! written.
+//! written. The directory is written whole in a staging directory beside it and renamed into
+//! place ([`Staged`]): under its name there is the old run or the new one, never half of one,
+//! whenever the process stops (an error, a signal, kill -9).
 
 use crate::rendered::Rendered;
 use crate::settings::Settings;
@@ -135,41 +137,47 @@ pub fn write(
     }
     let json_text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())? + "\n";
 
-    let out = o.out;
-    std::fs::create_dir_all(out.join("layers"))
-        .map_err(|e| format!("{}: cannot create output directory: {e}", out.display()))?;
-    // A run killed mid-write (kill -9) left its temp files: no run will finish or read them.
-    for dir in [out.to_path_buf(), out.join("layers"), out.join("snapshots")] {
-        for stale in temps::remove_stale(&dir) {
-            eprintln!("{stale}");
-        }
-    }
-    // A directory written before holds files this run may not replace (another method's
-    // layers, a plan): remove them first, so `image.json`, written last, never describes
-    // a mix of two runs, and a run that fails half-way leaves no `image.json` behind.
-    for name in ["image.json", "scene.toml", "plan.txt"] {
-        remove_if_present(&out.join(name))?;
-    }
-    for sub in ["layers", "snapshots"] {
-        if let Ok(dir) = std::fs::read_dir(out.join(sub)) {
-            for e in dir.flatten() {
-                if e.path().extension().is_some_and(|x| x == "exr") {
-                    remove_if_present(&e.path())?;
-                }
-            }
-        }
-    }
-    film::write_exr(out.join("image.exr"), &image).map_err(|e| e.to_string())?;
-    film::write_png(out.join("image.png"), &image, &tone).map_err(|e| e.to_string())?;
+    let staged = stage(o.out)?;
+    // Errors name the files by the place they were going to (the staging directory is
+    // removed).
+    write_files(
+        &staged,
+        &image,
+        &tone,
+        r,
+        &snapshot_images,
+        &scene_text,
+        &json_text,
+    )
+    .map_err(|e| staged.named(e))?;
+    staged.publish()?;
+    Ok((image, metrics))
+}
+
+fn write_files(
+    staged: &Staged,
+    image: &Image,
+    tone: &ToneMap,
+    r: &Rendered,
+    snapshot_images: &[(String, Image)],
+    scene_text: &str,
+    json_text: &str,
+) -> Result<(), String> {
+    let out = staged.path();
+    let mkdir = |d: &Path| {
+        std::fs::create_dir(d).map_err(|e| format!("{}: cannot create: {e}", d.display()))
+    };
+    mkdir(&out.join("layers"))?;
+    film::write_exr(out.join("image.exr"), image).map_err(|e| e.to_string())?;
+    film::write_png(out.join("image.png"), image, tone).map_err(|e| e.to_string())?;
     for l in &r.layers {
         film::write_exr(out.join("layers").join(format!("{}.exr", l.name)), &l.image)
             .map_err(|e| e.to_string())?;
     }
     if !snapshot_images.is_empty() {
-        std::fs::create_dir_all(out.join("snapshots"))
-            .map_err(|e| format!("{}: cannot create snapshots/: {e}", out.display()))?;
+        mkdir(&out.join("snapshots"))?;
     }
-    for (file, img) in &snapshot_images {
+    for (file, img) in snapshot_images {
         film::write_exr(out.join(file), img).map_err(|e| e.to_string())?;
     }
     let w = |name: &str, bytes: &[u8]| {
@@ -180,14 +188,96 @@ pub fn write(
         w("plan.txt", plan.to_string().as_bytes())?;
     }
     w("image.json", json_text.as_bytes())?;
-    Ok((image, metrics))
+    Ok(())
 }
 
-fn remove_if_present(p: &Path) -> Result<(), String> {
-    match std::fs::remove_file(p) {
-        Ok(()) => Ok(()),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(format!("{}: cannot replace: {e}", p.display())),
+/// What a run directory holds (and all it may hold to be replaced by another run).
+pub const RUN_FILES: [&str; 7] = [
+    "image.exr",
+    "image.png",
+    "image.json",
+    "scene.toml",
+    "plan.txt",
+    "layers",
+    "snapshots",
+];
+
+/// Refuses `out` unless a run directory may go there: absent, empty, or a run directory
+/// (only [`RUN_FILES`] and temps), which the new one replaces whole. Anything else there
+/// (a directory of the user's, the photon cache) is never removed.
+pub fn check_out(out: &Path) -> Result<(), String> {
+    if out.file_name().is_none() {
+        return Err(format!("{}: --out needs a directory name", out.display()));
+    }
+    let entries = match std::fs::read_dir(out) {
+        Ok(e) => e,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotADirectory => {
+            return Err(format!("{}: exists and is not a directory", out.display()));
+        }
+        Err(e) => return Err(format!("{}: cannot read: {e}", out.display())),
+    };
+    for e in entries {
+        let e = e.map_err(|e| format!("{}: cannot read: {e}", out.display()))?;
+        let name = e.file_name();
+        let name = name.to_string_lossy();
+        if !RUN_FILES.contains(&name.as_ref()) && temps::owner(&name).is_none() {
+            return Err(format!(
+                "{}: exists and is not a run directory (it holds `{name}`), which a run \
+                 replaces whole; choose another --out",
+                out.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A run directory being written: a staging directory beside its place, renamed into it by
+/// [`Staged::publish`] (replacing the old one whole), removed if dropped before (an error,
+/// Ctrl-C); one a killed process left is removed by the next run writing there.
+pub struct Staged {
+    tmp: temps::Temp,
+    out: std::path::PathBuf,
+}
+
+/// Starts writing the run directory `out` ([`check_out`] first).
+pub fn stage(out: &Path) -> Result<Staged, String> {
+    check_out(out)?;
+    let (tmp, stale) = temps::Temp::stage(out).map_err(|e| {
+        format!(
+            "{}: cannot create a staging directory beside it: {e}",
+            out.display()
+        )
+    })?;
+    for s in stale {
+        eprintln!("{s}");
+    }
+    Ok(Staged {
+        tmp,
+        out: out.to_path_buf(),
+    })
+}
+
+impl Staged {
+    /// Where to write the directory's files.
+    pub fn path(&self) -> &Path {
+        self.tmp.path()
+    }
+
+    /// `e` with the staging directory's path replaced by the run directory's, for a message.
+    pub fn named(&self, e: String) -> String {
+        e.replace(
+            &self.tmp.path().display().to_string(),
+            &self.out.display().to_string(),
+        )
+    }
+
+    /// Renames it into place, replacing the run directory there.
+    pub fn publish(self) -> Result<(), String> {
+        check_out(&self.out)?;
+        self.tmp
+            .replace(&self.out)
+            .map_err(|e| format!("{}: cannot rename into place: {e}", self.out.display()))
     }
 }
 

@@ -146,6 +146,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<String, String> {
 }
 
 fn merge_image(all: &[Input], order: &[usize], out: &Path) -> Result<String, String> {
+    crate::output::check_out(out)?;
     let a = &all[0];
     let scene_file = a.dir.join("scene.toml");
     // The shard's resolved scene: its settings are the run's, flags and all.

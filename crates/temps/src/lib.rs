@@ -125,8 +125,38 @@ impl Temp {
         }
     }
 
+    /// A staging directory for the directory `target`: its parent made if missing, and the
+    /// staging directories and set-aside copies of `target` that dead processes left beside
+    /// it removed first (returned, to be reported).
+    pub fn stage(target: &Path) -> io::Result<(Temp, Vec<Stale>)> {
+        if let Some(parent) = target.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(parent)?;
+        }
+        let stale = remove_stale_of(target);
+        Ok((Temp::dir(target)?, stale))
+    }
+
     pub fn path(&self) -> &Path {
         &self.path
+    }
+
+    /// Publishes it as `to`, replacing what is there without a moment when `to` is half of
+    /// either: the old one is moved aside ([`Temp::aside`]), this one renamed into place, and
+    /// the old one removed. A failed rename puts the old one back (and removes this one).
+    pub fn replace(self, to: &Path) -> io::Result<()> {
+        let old = match std::fs::symlink_metadata(to) {
+            Ok(_) => Some(Temp::aside(to)?),
+            Err(e) if e.kind() == io::ErrorKind::NotFound => None,
+            Err(e) => return Err(e),
+        };
+        if let Err(e) = self.publish(to) {
+            if let Some(old) = old {
+                let _ = old.publish(to);
+            }
+            return Err(e);
+        }
+        drop(old);
+        Ok(())
     }
 
     /// Renames it to `to` (replacing a file there), after which it is no longer a temp. On

@@ -155,3 +155,25 @@ fn stale_temps_are_removed_by_pid() {
     want.sort();
     assert_eq!(d.listing(), want);
 }
+
+#[test]
+fn a_staged_directory_replaces_the_old_one_whole() {
+    let d = Dir::new("replace");
+    let target = d.0.join("sub").join("run");
+    // A staging directory of a dead process beside the target is swept; the parent is made.
+    std::fs::create_dir_all(d.0.join("sub")).unwrap();
+    let dead = d.0.join("sub").join(format!(".run.tmp-{}-0", dead_pid()));
+    std::fs::create_dir(&dead).unwrap();
+    let (t, stale) = Temp::stage(&target).unwrap();
+    assert_eq!(stale.len(), 1, "{stale:?}");
+    std::fs::write(t.path().join("a"), b"1").unwrap();
+    t.replace(&target).unwrap();
+    assert_eq!(listing(&d.0.join("sub")), ["run"]);
+    assert_eq!(listing(&target), ["a"]);
+
+    let (t, _) = Temp::stage(&target).unwrap();
+    std::fs::write(t.path().join("b"), b"2").unwrap();
+    t.replace(&target).unwrap();
+    assert_eq!(listing(&d.0.join("sub")), ["run"]);
+    assert_eq!(listing(&target), ["b"]);
+}

@@ -830,12 +830,35 @@ fn interrupt(
     }
 }
 
+/// The temps under `dir` as [`temps_under`] lists them, and those inside staging
+/// directories too.
+#[cfg(unix)]
+fn temps_within(dir: &std::path::Path) -> Vec<String> {
+    let mut found = Vec::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if temps::owner(&name).is_some() {
+                found.push(e.path().strip_prefix(dir).unwrap().display().to_string());
+            }
+            if e.file_type().is_ok_and(|t| t.is_dir()) {
+                todo.push(e.path());
+            }
+        }
+    }
+    found.sort();
+    found
+}
+
 /// Signals `args`, a run writing a run directory at `out`, while it writes the k-th temp file
-/// there (k from `plan`), and checks that SIGINT removes what it was writing and that a
-/// kill -9's temp files stay until the next run into `out`, which removes them.
+/// into its staging directory beside `out` (k from `plan`), and checks that SIGINT removes
+/// what it was writing and that a kill -9's staging directory stays until the next run into
+/// `out`, which removes it; `out` itself never appears before a run finishes.
 #[cfg(unix)]
 fn interrupt_while_writing(args: &[&str], out: &std::path::Path) {
     use nix::sys::signal::Signal::{SIGINT, SIGKILL};
+    let beside = out.parent().unwrap();
     // Ending with a kill -9, whose files the rerun must remove.
     let plan = [
         (0, SIGINT),
@@ -846,27 +869,34 @@ fn interrupt_while_writing(args: &[&str], out: &std::path::Path) {
         (2, SIGKILL),
     ];
     for (k, signal) in plan {
-        // Every temp file of this run seen so far: the k-th has appeared once there are k + 1.
+        // Every temp file of this run seen so far inside its staging directory: the k-th has
+        // appeared once there are k + 1.
         let mut seen = std::collections::BTreeSet::new();
         let r = interrupt(
             args,
-            out,
-            &mut |temps, mine| {
-                seen.extend(temps.iter().filter(|t| t.contains(mine)).cloned());
+            beside,
+            &mut |_, mine| {
+                let files = temps_within(beside);
+                seen.extend(
+                    files
+                        .iter()
+                        .filter(|t| t.contains(mine) && t.contains('/'))
+                        .cloned(),
+                );
                 seen.len() > k
             },
             signal,
         );
-        // The run never finished: `image.json`, written last, says a directory is complete.
-        assert!(!out.join("image.json").exists(), "{signal} at file {k}");
-        let left = temps_under(out);
+        // The run never finished, so nothing of it is published.
+        assert!(!out.exists(), "{signal} at file {k}");
+        let left = temps_under(beside);
         if signal == SIGINT {
-            // Its own temp files removed on the signal, and a killed run's before it began
-            // writing (their process is gone).
+            // Its own staging directory removed on the signal, and a killed run's before it
+            // began writing (their process is gone).
             assert_eq!(r.status.code(), Some(130), "{signal} at file {k}");
             assert!(left.is_empty(), "{signal} at file {k} left {left:?}");
         } else {
-            // kill -9 cannot clean up: its temp file stays until the next run.
+            // kill -9 cannot clean up: its staging directory stays until the next run.
             assert!(left.iter().any(|t| t.contains(&r.mine)), "{left:?}");
         }
     }
@@ -874,8 +904,15 @@ fn interrupt_while_writing(args: &[&str], out: &std::path::Path) {
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{e}");
     assert!(out.join("image.json").exists());
-    assert!(temps_under(out).is_empty(), "kept: {:?}", temps_under(out));
-    assert!(e.contains("an unfinished file of process"), "{e}");
+    assert!(
+        temps_within(beside).is_empty(),
+        "kept: {:?}",
+        temps_within(beside)
+    );
+    assert!(
+        e.contains("an unfinished staging directory of process"),
+        "{e}"
+    );
 }
 
 /// Ctrl-C while `render` writes its images removes the ones being written; a kill -9's stay
