@@ -1,8 +1,9 @@
 //! Hand-rolled argument parsing: xtask keeps no dependencies so it compiles in seconds.
 
 pub const HELP: &str = "\
-cargo xtask <command>   (the photonflow commands build the release `photonflow` binary and run
-                         it; `photonflow <command> --help` has every option and the details)
+cargo xtask <command>   (the photonflow commands build the `photonflow` binary with the
+                         release-lto profile, the one benchmarks measure, and run it;
+                         `photonflow <command> --help` has every option and the details)
 
   render SCENE [--method path|global-direct|final-gather|caustic-splat|path+splat|sppm|light|vcm]
                [--spp N] [--passes N] [--time S] [--threads N] [--out DIR]
@@ -96,7 +97,7 @@ pub enum Cmd {
     SlurmDemo,
     /// The fuzz loops (`tests/bin/fuzz.rs`), with these arguments.
     Fuzz(Vec<String>),
-    /// Arguments passed straight to the photonflow binary (release build).
+    /// Arguments passed straight to the photonflow binary (`release-lto` build).
     Photonflow(Vec<String>),
     /// A benchmark: built with the `release-lto` profile, its output recorded in
     /// docs/benchmarks.md.
