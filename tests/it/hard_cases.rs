@@ -220,35 +220,13 @@ const CASES: &[Case] = &[
     Case {
         name: "light power near the f32 limit",
         scene: |dir| power_scene(dir, HUGE_LE).unwrap_or_else(|e| panic!("{e}")),
-        runs: || {
-            all(&[
-                Method::Path,
-                Method::GlobalDirect,
-                Method::FinalGather,
-                Method::CausticSplat,
-                Method::PathSplat,
-                Method::Sppm,
-                Method::Light,
-                Method::Vcm,
-            ])
-        },
+        runs: || all(&Method::ALL),
         check: check_huge_power,
     },
     Case {
         name: "plastics, thin glass, conductors",
         scene: |_| new_materials_worksheet(WS_RES),
-        runs: || {
-            all(&[
-                Method::Path,
-                Method::GlobalDirect,
-                Method::FinalGather,
-                Method::CausticSplat,
-                Method::PathSplat,
-                Method::Sppm,
-                Method::Light,
-                Method::Vcm,
-            ])
-        },
+        runs: || all(&Method::ALL),
         check: check_new_materials,
     },
 ];

@@ -617,8 +617,13 @@ impl LightTable {
     /// its plane), which NEE counts as a zero contribution.
     pub fn sample(&self, from: Vec3, u_pick: f32, u: [f32; 2]) -> Option<LightSample> {
         let i = self.distribution.sample(u_pick).0;
-        let e = &self.entries[i];
-        let (point, le, wi, dist, pdf) = e.light.sample_li(e.pmf, from, u, &self.sphere)?;
+        self.sample_of(i, self.entries[i].pmf, from, u)
+    }
+
+    /// Light `i`'s sample seen from `from`, the light chosen with probability `pmf`.
+    fn sample_of(&self, i: usize, pmf: f64, from: Vec3, u: [f32; 2]) -> Option<LightSample> {
+        let light = &self.entries.get(i)?.light;
+        let (point, le, wi, dist, pdf) = light.sample_li(pmf, from, u, &self.sphere)?;
         Some(LightSample {
             light: i,
             point,
@@ -626,7 +631,7 @@ impl LightTable {
             wi,
             dist,
             pdf,
-            delta: e.light.is_delta(),
+            delta: light.is_delta(),
         })
     }
 
@@ -641,20 +646,7 @@ impl LightTable {
     pub fn delta_samples(&self, from: Vec3) -> impl Iterator<Item = LightSample> + '_ {
         self.delta
             .iter()
-            .filter_map(|&i| Some((i, self.entries.get(i)?)))
-            .filter_map(move |(i, e)| {
-                let (point, le, wi, dist, pdf) =
-                    e.light.sample_li(1.0, from, [0.5, 0.5], &self.sphere)?;
-                Some(LightSample {
-                    light: i,
-                    point,
-                    le,
-                    wi,
-                    dist,
-                    pdf,
-                    delta: true,
-                })
-            })
+            .filter_map(move |&i| self.sample_of(i, 1.0, from, [0.5, 0.5]))
     }
 
     /// Solid-angle density with which [`LightTable::sample`] from `from` produces the point

@@ -1,7 +1,8 @@
 //! Meshes generated rather than read: Mitsuba 3's `rectangle`, `cube` and `disk`, each in
 //! its own space as Mitsuba defines it, placed by the mesh's transform.
 
-use super::{Builder, MAX_COORD};
+use super::Builder;
+use super::faces::Polygons;
 use crate::error::SceneError;
 use crate::file::{MeshDesc, ShapeKind};
 use geom::TriMesh;
@@ -27,7 +28,7 @@ impl Builder<'_> {
                 desc.source()
             )));
         };
-        let mut part = local(kind);
+        let part = local(kind);
         if kind == ShapeKind::Disk {
             self.warnings.push(format!(
                 "{}: mesh {index} (disk): drawn as a {DISK_SEGMENTS}-sided polygon of the \
@@ -35,24 +36,25 @@ impl Builder<'_> {
                 self.scene_path.display()
             ));
         }
-        for p in &mut part.positions {
-            let q = xf.transform_point3(p.as_dvec3());
-            if !q.is_finite() || q.abs().max_element() > MAX_COORD {
-                return Err(self.err(format!(
-                    "mesh {index} ({}): a vertex lies at {:?} after the transform, beyond the \
-                     {MAX_COORD:e} scene units photonflow can trace",
-                    desc.source(),
-                    q.to_array()
-                )));
-            }
-            *p = q.as_vec3();
-        }
-        if desc.flip_normals {
-            flip(&mut part);
-        }
-        part.materials = vec![mat; part.indices.len()];
-        self.mesh.append(&part);
-        Ok(())
+        // Through the path every mesh file takes: transform, checks, flip, append.
+        let positions: Vec<f32> = part.positions.iter().flat_map(|p| p.to_array()).collect();
+        let texcoords: Vec<f32> = part.texcoords.iter().flat_map(|t| t.to_array()).collect();
+        let indices: Vec<u32> = part.indices.iter().flatten().copied().collect();
+        let label = format!("mesh {index} ({})", desc.source());
+        let polygons = Polygons {
+            label: &label,
+            first: 0,
+            uv_keys: "texture coordinates",
+            positions: &positions,
+            normals: &[],
+            texcoords: &texcoords,
+            indices: &indices,
+            arities: &[],
+            material: mat,
+        };
+        let scene = self.scene_path.to_path_buf();
+        let err = |problem: String| SceneError::new(&scene, problem);
+        self.append_polygons(&polygons, desc, xf, &scene, &err)
     }
 }
 

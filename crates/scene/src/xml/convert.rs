@@ -371,13 +371,11 @@ impl<'a> Converter<'a> {
         // uniform scale.
         let lin = DMat3::from_mat4(m);
         let s = lin.x_axis.length();
-        let similar = [lin.y_axis, lin.z_axis]
+        // LᵀL = s² I: the columns orthogonal and of one length.
+        let similar = (lin.transpose() * lin - DMat3::from_diagonal(DVec3::splat(s * s)))
+            .to_cols_array()
             .iter()
-            .all(|a| (a.length() - s).abs() <= 1e-6 * s)
-            && (lin.transpose() * lin - DMat3::from_diagonal(DVec3::splat(s * s)))
-                .to_cols_array()
-                .iter()
-                .all(|v| v.abs() <= 1e-6 * s * s);
+            .all(|v| v.abs() <= 1e-6 * s * s);
         if !similar || s == 0.0 {
             return Err(p.err(
                 "`to_world` stretches the sphere unevenly: photonflow's spheres stay spheres",

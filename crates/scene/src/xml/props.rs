@@ -62,23 +62,44 @@ impl<'a> Plugin<'a> {
 
     /// The value child named `name`, marked read.
     fn value(&self, name: &str) -> Option<&'a Elem> {
-        let (i, c) =
-            self.e.children.iter().enumerate().find(|(_, c)| {
-                VALUE_TAGS.contains(&c.tag.as_str()) && c.attr("name") == Some(name)
-            })?;
-        if let Some(u) = self.used.borrow_mut().get_mut(i) {
-            *u = true;
-        }
+        let (i, c) = self.find_value(name)?;
+        self.mark(i);
         Some(c)
+    }
+
+    /// The value child named `name` and its index, not marked read.
+    fn find_value(&self, name: &str) -> Option<(usize, &'a Elem)> {
+        self.e
+            .children
+            .iter()
+            .enumerate()
+            .find(|(_, c)| VALUE_TAGS.contains(&c.tag.as_str()) && c.attr("name") == Some(name))
     }
 
     /// The tag of the value child named `name` (`float`, `string`, ...), not marking it read.
     pub fn tag_of(&self, name: &str) -> Option<&'a str> {
-        self.e
-            .children
-            .iter()
-            .find(|c| VALUE_TAGS.contains(&c.tag.as_str()) && c.attr("name") == Some(name))
-            .map(|c| c.tag.as_str())
+        self.find_value(name).map(|(_, c)| c.tag.as_str())
+    }
+
+    /// Child `i` marked read.
+    fn mark(&self, i: usize) {
+        if let Some(u) = self.used.borrow_mut().get_mut(i) {
+            *u = true;
+        }
+    }
+
+    /// `c`, or for a `<ref>` the element it names.
+    fn resolve(&self, c: &'a Elem) -> Result<&'a Elem, SceneError> {
+        if c.tag != "ref" {
+            return Ok(c);
+        }
+        let id = c
+            .attr("id")
+            .ok_or_else(|| c.err("needs the `id` it refers to"))?;
+        self.ids
+            .get(id)
+            .copied()
+            .ok_or_else(|| c.err(format_args!("refers to `{id}`, which no element declares")))
     }
 
     /// Marks a parameter read without reading it (one whose every value draws the same).
@@ -90,21 +111,9 @@ impl<'a> Plugin<'a> {
     pub fn objects(&self, tag: &str) -> Result<Vec<&'a Elem>, SceneError> {
         let mut out = Vec::new();
         for (i, c) in self.e.children.iter().enumerate() {
-            let target = if c.tag == "ref" {
-                let id = c
-                    .attr("id")
-                    .ok_or_else(|| c.err("needs the `id` it refers to"))?;
-                let t = self.ids.get(id).ok_or_else(|| {
-                    c.err(format_args!("refers to `{id}`, which no element declares"))
-                })?;
-                *t
-            } else {
-                c
-            };
+            let target = self.resolve(c)?;
             if target.tag == tag {
-                if let Some(u) = self.used.borrow_mut().get_mut(i) {
-                    *u = true;
-                }
+                self.mark(i);
                 out.push(target);
             }
         }
@@ -200,20 +209,11 @@ impl<'a> Plugin<'a> {
             if c.attr("name") != Some(name) || !matches!(c.tag.as_str(), "texture" | "ref") {
                 continue;
             }
-            let t = if c.tag == "ref" {
-                let id = c.attr("id").ok_or_else(|| c.err("needs `id`"))?;
-                *self.ids.get(id).ok_or_else(|| {
-                    c.err(format_args!("refers to `{id}`, which no element declares"))
-                })?
-            } else {
-                c
-            };
+            let t = self.resolve(c)?;
             if t.tag != "texture" {
                 return Err(c.err(format_args!("refers to {}, not a texture", t.describe())));
             }
-            if let Some(u) = self.used.borrow_mut().get_mut(i) {
-                *u = true;
-            }
+            self.mark(i);
             return Ok(Some(Color::Texture(t)));
         }
         Ok(None)
