@@ -344,3 +344,32 @@ impl Mean {
         (var.max(DVec3::ZERO) / self.n).powf(0.5)
     }
 }
+
+/// The noise of an estimate per `block` x `block` pixels (1: per pixel): per block and
+/// channel, the sample variance of its mean over `images` (one per seed) over the squared
+/// mean, averaged over the blocks and channels whose mean is above `1e-3`.
+pub fn relative_variance(images: &[Image], block: usize) -> f64 {
+    let n = images.len() as f64;
+    let (w, h) = (images[0].width / block, images[0].height / block);
+    let mean_of = |m: &Image, bx: usize, by: usize, c: usize| {
+        let mut s = 0.0f64;
+        for y in by * block..(by + 1) * block {
+            for x in bx * block..(bx + 1) * block {
+                s += f64::from(m.data[y * m.width + x][c]);
+            }
+        }
+        s / (block * block) as f64
+    };
+    let (mut sum, mut count) = (0.0f64, 0usize);
+    for (by, bx, c) in (0..h).flat_map(|y| (0..w).flat_map(move |x| (0..3).map(move |c| (y, x, c))))
+    {
+        let x: Vec<f64> = images.iter().map(|m| mean_of(m, bx, by, c)).collect();
+        let mean = x.iter().sum::<f64>() / n;
+        if mean > 1e-3 {
+            let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+            sum += var / (mean * mean);
+            count += 1;
+        }
+    }
+    sum / count.max(1) as f64
+}

@@ -140,3 +140,26 @@ fn vcm_is_the_same_for_any_thread_count() {
         "vcm differs between 1 and 3 threads"
     );
 }
+
+/// Eye subpaths draw pixel `p`'s pass `j` as sample `j` of the pixel's own scrambled Sobol
+/// sequence, light subpaths a pass's paths as one such sequence: 2-D strata per pair of
+/// dimensions across the passes and paths. Measured on the worksheet at 32 x 32, 16 passes,
+/// 8 seeds: relative variance per pixel 0.068 (independent draws, as before: 0.105, tried);
+/// bound 0.085.
+#[test]
+fn vcm_subpaths_are_stratified() {
+    let images: Vec<_> = (1..=8)
+        .map(|seed| {
+            let s = crate::kit::worksheet_with(32, seed, |_| {});
+            let o = Overrides {
+                method: Some(Method::Vcm),
+                passes: Some(16),
+                ..Overrides::default()
+            };
+            sum_layers(&render_uncached(&s, &o, None), |_| true)
+        })
+        .collect();
+    let v = crate::kit::relative_variance(&images, 1);
+    eprintln!("vcm: relative variance per pixel {v:.5}");
+    assert!(v < 0.085, "relative variance per pixel {v}");
+}

@@ -11,15 +11,19 @@
 //!
 //! Paths follow the photon tracer's rules (`trace.rs`): Russian roulette on the albedo at a
 //! Lambertian vertex, on the sample's weight at a glossy one; the flux is
-//! `Φ_i / (p_i N)` at emission. Path `i` of pass `j` draws from its own stream, so a pass's
-//! splats are a pure function of the scene and `(j, i)`.
+//! `Φ_i / (p_i N)` at emission. Path `i` of pass `j` is point `i` of pass `j`'s own
+//! scrambled Sobol sequence ([`math::SobolSampler`]: emission and scattering are 2-D strata
+//! over the pass's paths, as a pixel's samples are over its passes in the path tracer; Keller
+//! 1996, "Quasi-Monte Carlo methods for photorealistic image synthesis", §3), with its own
+//! stream for roulette at glossy vertices, so a pass's splats are a pure function of the scene
+//! and `(j, i)`.
 
 use crate::trace::bounce;
 use bsdf::TransportMode;
 use film::Class;
 use geom::SurfacePoint;
 use glam::{DVec3, Vec3};
-use math::{Frame, Rng};
+use math::{Frame, Rng, Sampler, SobolSampler};
 use scene::{Light, Scene, sides_agree};
 use std::ops::Range;
 
@@ -90,8 +94,10 @@ impl Tracer<'_> {
     fn path(&self, index: u64, out: &mut Vec<CameraSplat>) {
         let scene = self.scene;
         let mut rng = Rng::for_index(self.stream, index);
+        // Paths past 2^32 of one pass start another scrambled sequence.
+        let mut qmc = SobolSampler::new(math::mix64(self.stream ^ (index >> 32)), index as u32);
         // Fixed layout: 5 numbers to emit, then 3 per hit, used or not.
-        let (u_light, u_pos, u_dir) = (rng.uniform(), rng.uniform2(), rng.uniform2());
+        let (u_light, u_pos, u_dir) = (qmc.uniform(), qmc.uniform2(), qmc.uniform2());
         let lights = &scene.light_table;
         let e = lights.emit(u_light, u_pos, u_dir, self.photons);
         // The point on an area light seen by the camera: emission seen directly, `L E`.
@@ -111,7 +117,7 @@ impl Tracer<'_> {
                 return;
             };
             flux *= scene.transmittance_to(&hit, &ray);
-            let (uc, u) = (rng.uniform(), rng.uniform2());
+            let (uc, u) = (qmc.uniform(), qmc.uniform2());
             let Some(bsdf) = scene.bsdf_at(&hit) else {
                 return;
             };

@@ -6,7 +6,7 @@ use crate::{Grid, Pass, SubPath, mis, weights};
 use bsdf::TransportMode;
 use geom::Hit;
 use glam::{DVec3, Vec3};
-use math::{Frame, Rng};
+use math::{Frame, Sampler, SobolSampler, mix64};
 use scene::Scene;
 use std::ops::Range;
 
@@ -36,7 +36,9 @@ struct Vertex<'a> {
 fn pixel(scene: &Scene, pass: &Pass, light: &LightSide, index: u64) -> DVec3 {
     let cam = &scene.camera;
     let w = cam.width as u64;
-    let mut rng = Rng::for_index(pass.eye_stream, index);
+    // Pass `j` is sample `j` of the pixel's own scrambled Sobol sequence, as in the path
+    // tracer (pbrt-v4 §8.7.5's padded Sobol sampler).
+    let mut rng = SobolSampler::new(mix64(pass.eye_seed ^ mix64(index)), pass.index as u32);
     let [jx, jy] = rng.uniform2();
     let mut ray = cam.ray((index % w) as f32 + jx, (index / w) as f32 + jy);
     let cos = ray.d.normalize().dot(cam.forward());

@@ -121,7 +121,11 @@ pub struct Pass {
     /// Merging's kernel normalisation `1 / (π r² N)` (uniform kernel).
     pub(crate) vm_norm: f32,
     pub(crate) light_stream: u64,
-    pub(crate) eye_stream: u64,
+    /// The run's eye sequences: pixel `p`'s pass `j` is sample `j` of its own scrambled
+    /// Sobol sequence, seeded by this and `p` ([`math::SobolSampler`]).
+    pub(crate) eye_seed: u64,
+    /// This pass's number, the eye paths' sample index.
+    pub(crate) index: u64,
     /// Longest path in segments: `max_depth + 1`.
     pub(crate) max_len: u32,
 }
@@ -152,7 +156,8 @@ impl Pass {
             vc_factor: mis((1.0 / eta) as f32),
             vm_norm: (1.0 / eta) as f32,
             light_stream: stream ^ LIGHT_STREAM,
-            eye_stream: stream ^ EYE_STREAM,
+            eye_seed: mix64(seed ^ EYE_STREAM),
+            index: pass,
             max_len: opts.max_depth.saturating_add(1),
         }
     }

@@ -6,7 +6,7 @@ use crate::{Pass, SubPath, mis, weights};
 use bsdf::{Bsdf, TransportMode};
 use geom::{Ray, SurfacePoint};
 use glam::{DVec3, Vec3};
-use math::{Frame, Rng};
+use math::{Frame, Sampler, SobolSampler, mix64};
 use scene::Scene;
 use std::ops::Range;
 
@@ -89,7 +89,9 @@ fn trace(
     splats: &mut Vec<CameraSplat>,
 ) {
     let lights = &scene.light_table;
-    let mut rng = Rng::for_index(pass.light_stream, index);
+    // The pass's light subpaths are one scrambled Sobol sequence (2-D strata per pair of
+    // dimensions; past 2^32 paths, another one), as the light tracer's are.
+    let mut rng = SobolSampler::new(mix64(pass.light_stream ^ (index >> 32)), index as u32);
     // Fixed layout: 5 numbers to emit, then 4 per hit, used or not.
     let (u_light, u_pos, u_dir) = (rng.uniform(), rng.uniform2(), rng.uniform2());
     let e = lights.emit(u_light, u_pos, u_dir, 1);
