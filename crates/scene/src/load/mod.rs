@@ -26,6 +26,7 @@ mod lights;
 mod materials;
 mod mtl;
 mod obj;
+pub(crate) mod objtext;
 pub(crate) mod ply;
 mod shapes;
 mod transform;
