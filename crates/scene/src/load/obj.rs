@@ -7,6 +7,7 @@ use super::Builder;
 use super::faces::{FileErr, Polygons};
 use super::materials::{MTL_KEYS, Source};
 use super::mtl::{convert_mtl, prescan};
+use super::objtext::{self, ObjModel};
 use super::read_regular;
 use super::transform::transform;
 use crate::error::SceneError;
@@ -14,7 +15,6 @@ use crate::file::{EmissionSource, MeshDesc, TfReading};
 use glam::DMat4;
 use std::cell::RefCell;
 use std::collections::HashMap;
-use super::objtext::{self, ObjModel};
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
@@ -134,52 +134,49 @@ impl Builder<'_> {
         // bytes go before the models are formed.
         let read = objtext::read(&bytes, objtext::CHUNK);
         drop(bytes);
-        let loaded = objtext::form(
-            read,
-            |p: &Path| {
-                if !read_mtl {
-                    return Ok(Default::default());
+        let loaded = objtext::form(read, |p: &Path| {
+            if !read_mtl {
+                return Ok(Default::default());
+            }
+            let mtl_path = obj_dir.join(p);
+            match read_regular(&mtl_path) {
+                Ok(b) => {
+                    mtl_bytes.borrow_mut().extend_from_slice(&b);
+                    mtl_files.borrow_mut().push(p.display().to_string());
+                    let b = match prescan(&b) {
+                        Ok(b) => b,
+                        Err(problem) => {
+                            *mtl_error.borrow_mut() = Some(SceneError::new(
+                                &mtl_path,
+                                format!("malformed MTL file: {problem} ({of})"),
+                            ));
+                            return Err(tobj::LoadError::MaterialParseError);
+                        }
+                    };
+                    tobj::load_mtl_buf(&mut BufReader::new(&b[..]))
+                        .inspect(|(mats, _)| {
+                            let names = mats.iter().map(|m| m.name.clone()).collect();
+                            mtl_of.borrow_mut().push((mtl_path.clone(), names));
+                        })
+                        .inspect_err(|e| {
+                            *mtl_error.borrow_mut() = Some(SceneError::new(
+                                &mtl_path,
+                                format!("malformed MTL file: {e} ({of})"),
+                            ));
+                        })
                 }
-                let mtl_path = obj_dir.join(p);
-                match read_regular(&mtl_path) {
-                    Ok(b) => {
-                        mtl_bytes.borrow_mut().extend_from_slice(&b);
-                        mtl_files.borrow_mut().push(p.display().to_string());
-                        let b = match prescan(&b) {
-                            Ok(b) => b,
-                            Err(problem) => {
-                                *mtl_error.borrow_mut() = Some(SceneError::new(
-                                    &mtl_path,
-                                    format!("malformed MTL file: {problem} ({of})"),
-                                ));
-                                return Err(tobj::LoadError::MaterialParseError);
-                            }
-                        };
-                        tobj::load_mtl_buf(&mut BufReader::new(&b[..]))
-                            .inspect(|(mats, _)| {
-                                let names = mats.iter().map(|m| m.name.clone()).collect();
-                                mtl_of.borrow_mut().push((mtl_path.clone(), names));
-                            })
-                            .inspect_err(|e| {
-                                *mtl_error.borrow_mut() = Some(SceneError::new(
-                                    &mtl_path,
-                                    format!("malformed MTL file: {e} ({of})"),
-                                ));
-                            })
-                    }
-                    Err(e) => {
-                        *mtl_error.borrow_mut() = Some(SceneError::new(
-                            &mtl_path,
-                            format!(
-                                "cannot read MTL file named by `mtllib` in {}: {e} ({of})",
-                                obj_path.display()
-                            ),
-                        ));
-                        Err(tobj::LoadError::OpenFileFailed)
-                    }
+                Err(e) => {
+                    *mtl_error.borrow_mut() = Some(SceneError::new(
+                        &mtl_path,
+                        format!(
+                            "cannot read MTL file named by `mtllib` in {}: {e} ({of})",
+                            obj_path.display()
+                        ),
+                    ));
+                    Err(tobj::LoadError::OpenFileFailed)
                 }
-            },
-        );
+            }
+        });
         if let Some(e) = mtl_error.into_inner() {
             return Err(e);
         }

@@ -374,7 +374,10 @@ fn cuts(bytes: &[u8], size: usize) -> Vec<usize> {
     let mut at = 0;
     while at + size < bytes.len() {
         let from = at + size;
-        match bytes.get(from..).and_then(|b| b.iter().position(|&c| c == b'\n')) {
+        match bytes
+            .get(from..)
+            .and_then(|b| b.iter().position(|&c| c == b'\n'))
+        {
             Some(p) => at = from + p + 1,
             None => break,
         }
@@ -582,13 +585,14 @@ pub(crate) struct Read(Vec<Chunk>);
 
 pub(crate) fn read(bytes: &[u8], chunk: usize) -> Read {
     let cuts = cuts(bytes, chunk.max(1));
-    Read(cuts
-        .par_windows(2)
-        .map(|w| match w {
-            [a, b] => read_chunk(bytes.get(*a..*b).unwrap_or_default()),
-            _ => Chunk::default(),
-        })
-        .collect())
+    Read(
+        cuts.par_windows(2)
+            .map(|w| match w {
+                [a, b] => read_chunk(bytes.get(*a..*b).unwrap_or_default()),
+                _ => Chunk::default(),
+            })
+            .collect(),
+    )
 }
 
 /// The models of a [`read`] file, its directives followed in file order. `load_mtl` reads the

@@ -85,7 +85,10 @@ fn by_tobj(bytes: &[u8]) -> Outcome {
             face_arities: m.mesh.face_arities,
         })
         .collect();
-    Ok((models, mats.map(|v| v.into_iter().map(|m| m.name).collect())))
+    Ok((
+        models,
+        mats.map(|v| v.into_iter().map(|m| m.name).collect()),
+    ))
 }
 
 fn by_objtext(bytes: &[u8], chunk: usize) -> (Outcome, Option<(Vec<(usize, String)>, usize)>) {
@@ -220,5 +223,8 @@ fn a_file_over_many_chunks_reads_as_one() {
         panic!("{got:?}")
     };
     assert_eq!(models.len(), 4);
-    assert_eq!(models.iter().map(|m| m.indices.len()).sum::<usize>(), 2 * 2998 * 3);
+    assert_eq!(
+        models.iter().map(|m| m.indices.len()).sum::<usize>(),
+        2 * 2998 * 3
+    );
 }
