@@ -91,7 +91,10 @@ fn by_tobj(bytes: &[u8]) -> Outcome {
     ))
 }
 
-fn by_objtext(bytes: &[u8], chunk: usize) -> (Outcome, Option<(Vec<(usize, String)>, usize)>) {
+/// The `usemtl` list and the count of lines that are neither blank nor comments.
+type Directives = (Vec<(usize, String)>, usize);
+
+fn by_objtext(bytes: &[u8], chunk: usize) -> (Outcome, Option<Directives>) {
     match objtext::form(objtext::read(bytes, chunk), mtl) {
         Ok(t) => (
             Ok((
@@ -105,7 +108,7 @@ fn by_objtext(bytes: &[u8], chunk: usize) -> (Outcome, Option<(Vec<(usize, Strin
 }
 
 /// The `usemtl` list and line count as `obj.rs` computed them before (its whole-file scan).
-fn directives(bytes: &[u8]) -> (Vec<(usize, String)>, usize) {
+fn directives(bytes: &[u8]) -> Directives {
     let mut usemtl: Vec<(usize, String)> = Vec::new();
     let mut lines = 0;
     for (i, line) in String::from_utf8_lossy(bytes).lines().enumerate() {
