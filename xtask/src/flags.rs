@@ -76,6 +76,9 @@ cargo xtask <command>   (the photonflow commands build the `photonflow` binary w
                       tests/references/peer.sh's mitsuba, mitsuba-ptracer, luxcore, cycles,
                       smallvcm-ppm, smallvcm-bpt, smallvcm-vcm (set PEERS, PEERS_VENV, BPY_VENV), or shell
                       commands writing an EXR to $OUT (also given $SCENE, $BUDGET)
+  bench load [--sizes 100000,1000000,4000000] [--runs N] [--dir DIR]
+                      load time (parse, BVH) and peak memory of generated meshes, each load a
+                      fresh process; Mitsuba 3 beside it in the same run when PEERS_VENV is set
   bench knn [--photons N] [--queries N]
                       k-NN queries/s for k = 50, 250, 1000 per index (kd-tree, kiddo, brute),
                       and pixel-order irradiance queries with radius hints
@@ -129,7 +132,9 @@ pub const FORWARDED: &[&str] = &[
 ];
 
 /// `bench <what>`: the binary's `bench-<what>`, its output recorded in docs/benchmarks.md.
-pub const BENCHES: &[&str] = &["rays", "photons", "store", "knn", "splat", "accuracy"];
+pub const BENCHES: &[&str] = &[
+    "rays", "photons", "store", "knn", "splat", "accuracy", "load",
+];
 
 /// The commands xtask runs itself. `parse` matches each by name, so only the tests read the
 /// list: its own test holds it to `parse` and the help, photonflow's to README's table.

@@ -59,6 +59,8 @@ pub struct Geometry {
     /// Original triangle id of each entry of `rt`.
     rt_ids: Vec<u32>,
     bounds: Bounds3,
+    /// Seconds the index took to build (for `bench-load`).
+    build_seconds: f64,
 }
 
 impl Geometry {
@@ -67,6 +69,7 @@ impl Geometry {
     }
 
     pub fn with_bvh(mesh: TriMesh, spheres: Vec<Sphere>, kind: BvhKind) -> Geometry {
+        let start = std::time::Instant::now();
         let (accel, order, rt) = match kind {
             BvhKind::Bvh4 => {
                 // `slow_build` and `very_slow_build` (more PLOC search, more reinsertion; their
@@ -114,7 +117,13 @@ impl Geometry {
             rt,
             rt_ids: order,
             bounds,
+            build_seconds: start.elapsed().as_secs_f64(),
         }
+    }
+
+    /// Seconds the ray-casting index took to build.
+    pub fn build_seconds(&self) -> f64 {
+        self.build_seconds
     }
 
     pub fn mesh(&self) -> &TriMesh {

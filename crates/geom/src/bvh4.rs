@@ -14,9 +14,12 @@
 use crate::float::{gamma, next_down, next_up};
 use crate::simd::{F4, Lanes};
 use crate::{Prim, Ray, Sphere, TriMesh};
-use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::Bvh2, bvh2::builder::build_bvh2};
+use obvhs::bvh2::{
+    Bvh2, leaf_collapser::collapse, node::Bvh2Node, reinsertion::ReinsertionOptimizer,
+};
+use obvhs::ploc::{PlocBuilder, PlocSearchDistance};
+use obvhs::{BvhBuildParams, aabb::Aabb};
 use std::ops::{Add, Div, Mul, Sub};
-use std::time::Duration;
 
 /// Child reference: an inner node's index, or a leaf tagged by `LEAF`.
 pub(crate) const LEAF: u32 = 1 << 31;
@@ -248,7 +251,6 @@ impl Bvh4 {
             bvh2: &bvh2,
             n_tri: n_tri as u32,
             mesh,
-            cost: vec![[0.0; 4]; bvh2.nodes.len()],
             choice: vec![[Choice::Leaf; 4]; bvh2.nodes.len()],
             out: Bvh4 {
                 nodes: Vec::new(),
@@ -481,31 +483,80 @@ enum Choice {
 /// The obvhs `Bvh2` the collapse starts from: triangles, then spheres, one primitive per
 /// leaf (the collapse forms the leaves, and keeps spheres out of triangle blocks). `None`
 /// when there is nothing to index.
+///
+/// The steps of obvhs' `build_bvh2` (obvhs 0.4, `bvh2/builder.rs`: PLOC, reinsertion,
+/// collapse, reinsertion) with PLOC's leaves written straight from the mesh, not from a list
+/// of boxes the builder copies (32 bytes a triangle less at the load's peak): the same `Bvh2`,
+/// which `tests.rs` checks against `build_bvh2`.
 pub(crate) fn binary_bvh(
     mesh: &TriMesh,
     spheres: &[Sphere],
     params: BvhBuildParams,
 ) -> Option<Bvh2> {
-    let mut aabbs: Vec<Aabb> = (0..mesh.len())
-        .map(|i| {
-            let [a, b, c] = mesh.vertices(i);
-            Aabb::new(a.min(b).min(c).into(), a.max(b).max(c).into())
-        })
-        .collect();
-    // The f32 box of a sphere, widened by an ulp so it contains the exact sphere.
-    aabbs.extend(spheres.iter().map(|s| {
+    let n = mesh.len() + spheres.len();
+    if n == 0 {
+        return None;
+    }
+    let mut bvh = Bvh2::zeroed(n);
+    bvh.reset_for_reuse(n, Some((0..n as u32).collect()));
+    let mut ploc = PlocBuilder::with_capacity(n);
+    let mut total = Aabb::empty();
+    ploc.current_nodes.clear();
+    ploc.current_nodes
+        .extend(prim_boxes(mesh, spheres).enumerate().map(|(i, b)| {
+            total.extend(b.min);
+            total.extend(b.max);
+            Bvh2Node::new(b, 1, i as u32)
+        }));
+    let (precision, depth) = (params.sort_precision, params.search_depth_threshold);
+    match params.ploc_search_distance {
+        PlocSearchDistance::Minimum => {
+            ploc.build_ploc_from_leaves::<1, false>(&mut bvh, total, precision, depth)
+        }
+        PlocSearchDistance::VeryLow => {
+            ploc.build_ploc_from_leaves::<2, false>(&mut bvh, total, precision, depth)
+        }
+        PlocSearchDistance::Low => {
+            ploc.build_ploc_from_leaves::<6, false>(&mut bvh, total, precision, depth)
+        }
+        PlocSearchDistance::Medium => {
+            ploc.build_ploc_from_leaves::<14, false>(&mut bvh, total, precision, depth)
+        }
+        PlocSearchDistance::High => {
+            ploc.build_ploc_from_leaves::<24, false>(&mut bvh, total, precision, depth)
+        }
+        PlocSearchDistance::VeryHigh => {
+            ploc.build_ploc_from_leaves::<32, false>(&mut bvh, total, precision, depth)
+        }
+    }
+    drop(ploc);
+    let mut reinsertion = ReinsertionOptimizer::default();
+    reinsertion.run(&mut bvh, params.reinsertion_batch_ratio, None);
+    // One primitive per leaf: the collapse forms the leaves.
+    collapse(&mut bvh, 1, params.collapse_traversal_cost);
+    reinsertion.run(
+        &mut bvh,
+        params.reinsertion_batch_ratio * params.post_collapse_reinsertion_batch_ratio_multiplier,
+        None,
+    );
+    Some(bvh)
+}
+
+/// Each primitive's box: triangles, then spheres (the f32 box of a sphere widened by an ulp
+/// so it contains the exact sphere).
+pub(crate) fn prim_boxes<'a>(
+    mesh: &'a TriMesh,
+    spheres: &'a [Sphere],
+) -> impl Iterator<Item = Aabb> + 'a {
+    let tris = (0..mesh.len()).map(|i| {
+        let [a, b, c] = mesh.vertices(i);
+        Aabb::new(a.min(b).min(c).into(), a.max(b).max(c).into())
+    });
+    tris.chain(spheres.iter().map(|s| {
         let lo = (s.center - s.radius).to_array().map(next_down);
         let hi = (s.center + s.radius).to_array().map(next_up);
         Aabb::new(glam::Vec3A::from_array(lo), glam::Vec3A::from_array(hi))
-    }));
-    if aabbs.is_empty() {
-        return None;
-    }
-    let params = BvhBuildParams {
-        max_prims_per_leaf: 1,
-        ..params
-    };
-    Some(build_bvh2(&aabbs, params, &mut Duration::default()))
+    }))
 }
 
 struct Builder<'a> {
@@ -513,9 +564,9 @@ struct Builder<'a> {
     /// Primitives `0..n_tri` are triangles, the rest spheres.
     n_tri: u32,
     mesh: &'a TriMesh,
-    /// Per Bvh2 node and slot count `i` (index `i - 1`): least SAH cost of the subtree as a
-    /// forest of at most `i` subtrees, and the choice that reaches it.
-    cost: Vec<[f64; 4]>,
+    /// Per Bvh2 node and slot count `i` (index `i - 1`): the choice that reaches the least
+    /// SAH cost of the subtree as a forest of at most `i` subtrees. The costs themselves
+    /// travel up the recursion: a node's are read by its parent only.
     choice: Vec<[Choice; 4]>,
     out: Bvh4,
 }
@@ -529,23 +580,21 @@ impl Builder<'_> {
     /// The optimal collapse of a binary BVH into a wide one by dynamic programming over
     /// (node, slots), Ylitie, Karras and Laine, "Efficient Incoherent Ray Traversal on GPUs
     /// Through Compressed Wide BVHs" (HPG 2017) §4.1, with our leaf rule: one sphere, or up
-    /// to `LEAF_MAX` triangles. Returns the subtree's primitive count and whether it holds a
-    /// sphere.
-    fn optimize(&mut self, ni: usize) -> (u32, bool) {
+    /// to `LEAF_MAX` triangles. Returns the subtree's primitive count, whether it holds a
+    /// sphere, and its least cost in 1 to 4 slots.
+    fn optimize(&mut self, ni: usize) -> (u32, bool, [f64; 4]) {
         let node = self.bvh2.nodes[ni];
         let area = node.aabb().half_area() as f64;
         let Some((l, r)) = self.children(ni) else {
             let p = self.bvh2.primitive_indices[node.first_index as usize];
             let is_sphere = p >= self.n_tri;
             let c = area * if is_sphere { COST_SPHERE } else { COST_BLOCK };
-            self.cost[ni] = [c; 4];
             self.choice[ni] = [Choice::Leaf; 4];
-            return (1, is_sphere);
+            return (1, is_sphere, [c; 4]);
         };
-        let (nl, sl) = self.optimize(l);
-        let (nr, sr) = self.optimize(r);
+        let (nl, sl, cl) = self.optimize(l);
+        let (nr, sr, cr) = self.optimize(r);
         let (count, sphere) = (nl + nr, sl || sr);
-        let (cl, cr) = (self.cost[l], self.cost[r]);
         // Best split of `i` slots between the two children.
         let split = |i: usize| {
             (1..i)
@@ -571,9 +620,8 @@ impl Builder<'_> {
                 (cost[i - 2], Choice::Fewer)
             };
         }
-        self.cost[ni] = cost;
         self.choice[ni] = choice;
-        (count, sphere)
+        (count, sphere, cost)
     }
 
     /// The roots of the forest that stands for subtree `ni` in `i` slots.

@@ -597,3 +597,192 @@ pub fn splat(path: &Path, photons: u64, runs: usize) -> Result<(), String> {
     }
     Ok(())
 }
+
+/// The height field of `bench-load`: a grid of `w` x `h` quads (two triangles each) over
+/// [-1, 1]^2 in x and z, as an OBJ of positions and faces only (39 bytes a triangle).
+fn height_field_obj(w: usize, h: usize) -> String {
+    use std::fmt::Write;
+    let mut s = String::with_capacity(40 * 2 * w * h);
+    s += "# photonflow bench-load height field\n";
+    for j in 0..=h {
+        let z = -1.0 + 2.0 * j as f64 / h as f64;
+        for i in 0..=w {
+            let x = -1.0 + 2.0 * i as f64 / w as f64;
+            let y = 0.2 + 0.1 * (9.0 * x).sin() * (7.0 * z).cos();
+            let _ = writeln!(s, "v {x:.6} {y:.6} {z:.6}");
+        }
+    }
+    let row = w + 1;
+    for j in 0..h {
+        for i in 0..w {
+            let a = j * row + i + 1;
+            let (b, c, d) = (a + 1, a + row, a + row + 1);
+            let _ = writeln!(s, "f {a} {c} {b}\nf {b} {c} {d}");
+        }
+    }
+    s
+}
+
+/// The scene around a mesh: a box of side 4 seen from inside, a square light under its top.
+fn load_scene(obj: &str) -> String {
+    format!(
+        "name = \"bench-load\"\nseed = 1\n[camera]\neye = [0.0, 1.0, 3.0]\n\
+         look_at = [0.0, 0.0, 0.0]\nvfov = 50.0\nwidth = 32\nheight = 32\n\
+         [material.white]\ntype = \"lambertian\"\nalbedo = [0.8, 0.8, 0.8]\n\
+         [[mesh]]\nshape = \"cube\"\nmaterial = \"white\"\nscale = 2.0\nflip_normals = true\n\
+         [[mesh]]\nshape = \"rectangle\"\nmaterial = \"white\"\nscale = 0.5\n\
+         rotate = [90, 0, 0]\ntranslate = [0, 1.9, 0]\nradiance = [10, 10, 10]\n\
+         [[mesh]]\nobj = \"{obj}\"\nmaterial = \"white\"\n"
+    )
+}
+
+/// Mitsuba 3's side of `bench-load`: the same OBJ and scene through `load_dict`.
+const MITSUBA_LOAD: &str = r#"import sys, time, resource
+import mitsuba as mi
+mi.set_variant("llvm_ad_rgb")
+t1 = time.perf_counter()
+shape = mi.load_dict({"type": "obj", "filename": sys.argv[1], "bsdf": {"type": "diffuse"}})
+t2 = time.perf_counter()
+T = mi.ScalarTransform4f
+scene = mi.load_dict({"type": "scene", "mesh": shape,
+    "box": {"type": "cube", "to_world": T().scale(2.0), "flip_normals": True},
+    "light": {"type": "rectangle",
+              "to_world": T().translate([0, 1.9, 0]).rotate([1, 0, 0], 90).scale(0.5),
+              "emitter": {"type": "area", "radiance": 10.0}}})
+t3 = time.perf_counter()
+print(f"parse {t2 - t1} build {t3 - t2} total {t3 - t1} peak_kib {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss}")
+"#;
+
+/// One load's figures: parse, build and total seconds, peak MiB.
+type LoadRun = [f64; 4];
+
+/// Reads `parse P build B total T peak_kib K` from a run's output.
+fn load_figures(out: &str) -> Option<LoadRun> {
+    let line = out.lines().rev().find(|l| l.starts_with("parse "))?;
+    let w: Vec<&str> = line.split_whitespace().collect();
+    let num = |k: &str| -> Option<f64> {
+        let i = w.iter().position(|x| *x == k)?;
+        w.get(i + 1)?.parse().ok()
+    };
+    Some([
+        num("parse")?,
+        num("build")?,
+        num("total")?,
+        num("peak_kib")? / 1024.0,
+    ])
+}
+
+/// `bench-load --child SCENE`: loads the scene once and prints its figures.
+pub fn load_child(scene: &Path) -> Result<(), String> {
+    let start = Instant::now();
+    let s = scene::Scene::load(scene).map_err(|e| e.to_string())?;
+    let total = start.elapsed().as_secs_f64();
+    let build = s.geometry.build_seconds();
+    let kib = proc_status("VmHWM")
+        .and_then(|v| v.split_whitespace().next()?.parse::<f64>().ok())
+        .ok_or("no VmHWM in /proc/self/status")?;
+    println!(
+        "parse {} build {build} total {total} peak_kib {kib} triangles {}",
+        total - build,
+        s.geometry.mesh().len()
+    );
+    Ok(())
+}
+
+/// `bench-load`: per mesh size, `runs` loads by photonflow and (with `PEERS_VENV`) Mitsuba 3
+/// alternately, each in its own process; medians of parse, build, total and peak memory.
+pub fn load(sizes: &[usize], runs: usize, dir: &Path) -> Result<(), String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+    let python = std::env::var_os("PEERS_VENV").map(|v| Path::new(&v).join("bin/python"));
+    let script = dir.join("mitsuba_load.py");
+    std::fs::write(&script, MITSUBA_LOAD).map_err(|e| format!("{}: {e}", script.display()))?;
+    println!(
+        "| triangles | loader | parse s | BVH s | total s | peak MB | bytes/triangle | total / Mitsuba | peak / Mitsuba |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for &n in sizes {
+        // w x h quads, w = 2h: 2 w h = n triangles (rounded).
+        let h = ((n as f64 / 4.0).sqrt().round() as usize).max(1);
+        let w = (n / (2 * h)).max(1);
+        let tris = 2 * w * h;
+        let obj = dir.join(format!("height-{w}x{h}.obj"));
+        if !obj.exists() {
+            let tmp = dir.join(format!(".height-{w}x{h}.obj.tmp"));
+            std::fs::write(&tmp, height_field_obj(w, h))
+                .and_then(|()| std::fs::rename(&tmp, &obj))
+                .map_err(|e| format!("{}: {e}", obj.display()))?;
+        }
+        let toml = dir.join(format!("height-{w}x{h}.toml"));
+        std::fs::write(&toml, load_scene(&format!("height-{w}x{h}.obj")))
+            .map_err(|e| format!("{}: {e}", toml.display()))?;
+        let mut ours: Vec<LoadRun> = Vec::new();
+        let mut theirs: Vec<LoadRun> = Vec::new();
+        for _ in 0..runs.max(1) {
+            let out = std::process::Command::new(&exe)
+                .args(["bench-load", "--child"])
+                .arg(&toml)
+                .output()
+                .map_err(|e| e.to_string())?;
+            let text = String::from_utf8_lossy(&out.stdout);
+            ours.push(load_figures(&text).ok_or_else(|| {
+                format!(
+                    "photonflow's load failed: {}",
+                    String::from_utf8_lossy(&out.stderr)
+                )
+            })?);
+            if let Some(py) = &python {
+                let out = std::process::Command::new(py)
+                    .arg(&script)
+                    .arg(&obj)
+                    .output()
+                    .map_err(|e| format!("{}: {e}", py.display()))?;
+                let text = String::from_utf8_lossy(&out.stdout);
+                theirs.push(load_figures(&text).ok_or_else(|| {
+                    format!(
+                        "Mitsuba's load failed: {}",
+                        String::from_utf8_lossy(&out.stderr)
+                    )
+                })?);
+            }
+        }
+        let median = |runs: &[LoadRun], k: usize| {
+            let mut v: Vec<f64> = runs.iter().map(|r| r[k]).collect();
+            v.sort_by(f64::total_cmp);
+            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+        };
+        let ours_m: Vec<f64> = (0..4).map(|k| median(&ours, k)).collect();
+        let theirs_m: Vec<f64> = (0..4).map(|k| median(&theirs, k)).collect();
+        let row = |who: &str, m: &[f64], ratio: String| {
+            println!(
+                "| {tris} | {who} | {:.2} | {:.2} | {:.2} | {:.0} | {:.0} | {ratio} |",
+                m[0],
+                m[1],
+                m[2],
+                m[3] * 1.048576,
+                m[3] * 1048576.0 / tris as f64
+            );
+        };
+        if theirs.is_empty() {
+            row("photonflow", &ours_m, "| ".to_string());
+        } else {
+            row(
+                "photonflow",
+                &ours_m,
+                format!(
+                    "{:.2} | {:.2}",
+                    ours_m[2] / theirs_m[2],
+                    ours_m[3] / theirs_m[3]
+                ),
+            );
+            row("Mitsuba 3", &theirs_m, "1 | 1".to_string());
+        }
+    }
+    println!(
+        "\nmedians of {} run(s) per loader, alternating, each a fresh process; peak: VmHWM \
+         (photonflow), ru_maxrss (Mitsuba: Python and the JIT included); Mitsuba's parse is \
+         `load_dict` of the OBJ, its BVH the scene's `load_dict` around it",
+        runs.max(1)
+    );
+    Ok(())
+}

@@ -114,6 +114,15 @@ fn run(cmd: Cmd, d: &Defines) -> Result<(), String> {
             runs,
         }) => lab::bench::splat(&scene, photons, runs),
         Cmd::BenchKnn(cli::BenchKnn { photons, queries }) => lab::bench::knn(photons, queries),
+        Cmd::BenchLoad(cli::BenchLoad {
+            sizes,
+            runs,
+            dir,
+            child,
+        }) => match child {
+            Some(scene) => lab::bench::load_child(&scene),
+            None => lab::bench::load(&sizes, runs, &dir),
+        },
         Cmd::BenchAccuracy(a) => bench_accuracy(a),
         Cmd::Evidence(a) => evidence(a),
         Cmd::Worksheet(a) => worksheet(a, d),

@@ -18,6 +18,8 @@ mod materials;
 mod mtl;
 /// OBJ loading and its errors.
 mod obj;
+/// The parallel OBJ reader against tobj, on tricky and mutated files, in chunks of any size.
+mod objtext;
 /// PLY loading and its errors.
 mod ply;
 /// Faces to triangles.

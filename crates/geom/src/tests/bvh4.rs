@@ -2,7 +2,7 @@
 
 use crate::bvh4::{
     Bvh4, COST_BLOCK, COST_NODE, COST_SPHERE, COUNT_SHIFT, EMPTY, LEAF, LEAF_MAX, SPHERE,
-    binary_bvh,
+    binary_bvh, prim_boxes,
 };
 use crate::{Sphere, TriMesh};
 use glam::Vec3;
@@ -196,4 +196,41 @@ fn the_collapse_beats_the_greedy_one_on_a_larger_scene() {
     };
     let (got, greedy) = (emitted_cost(&b), t.greedy(0));
     assert!(got < 0.96 * greedy, "optimal {got}, greedy {greedy}");
+}
+
+/// `binary_bvh` writes PLOC's leaves from the mesh itself instead of a list of boxes: the
+/// `Bvh2` must be the one obvhs' `build_bvh2` makes from those boxes, node for node (sizes
+/// past PLOC's and the sort's parallel and radix thresholds, and the build presets' other
+/// search distances and sort precisions).
+#[test]
+fn the_lean_binary_build_is_obvhs_build() {
+    use obvhs::bvh2::builder::build_bvh2;
+    let presets = [
+        BvhBuildParams::medium_build(),
+        BvhBuildParams::fast_build(),
+        BvhBuildParams::very_fast_build(),
+    ];
+    for (n_tri, n_sph) in [(1, 0), (0, 2), (37, 3), (5000, 4), (300_000, 0)] {
+        let (mesh, spheres) = scene(n_tri, n_sph, 7 + n_tri as u64);
+        for params in presets {
+            let params = BvhBuildParams {
+                max_prims_per_leaf: 1,
+                ..params
+            };
+            let lean = binary_bvh(&mesh, &spheres, params).unwrap();
+            let boxes: Vec<_> = prim_boxes(&mesh, &spheres).collect();
+            let full = build_bvh2(&boxes, params, &mut Default::default());
+            assert_eq!(lean.primitive_indices, full.primitive_indices);
+            assert_eq!(lean.nodes.len(), full.nodes.len());
+            for (a, b) in lean.nodes.iter().zip(&full.nodes) {
+                assert_eq!(
+                    (a.aabb().min, a.aabb().max, a.prim_count, a.first_index),
+                    (b.aabb().min, b.aabb().max, b.prim_count, b.first_index)
+                );
+            }
+            if n_tri == 300_000 {
+                break;
+            }
+        }
+    }
 }

@@ -138,3 +138,29 @@ pub(crate) struct BenchKnn {
     #[arg(long, default_value_t = 20_000)]
     pub(crate) queries: usize,
 }
+
+/// Load time and peak memory of generated meshes of 0.1M, 1M and 4M triangles, beside Mitsuba
+/// 3 loading the same files.
+///
+/// Each mesh is a height field written as an OBJ (deterministic; generated once into --dir)
+/// in a box under an area light. Every run loads the scene in a fresh process (`info`'s
+/// load: OBJ parse and the mesh appended, then the BVH), which reports its parse and build
+/// time and its peak resident memory (VmHWM). With PEERS_VENV set, Mitsuba 3 (`llvm_ad_rgb`,
+/// `load_dict` of the OBJ, then of the scene around it) runs alternately with it, its
+/// interpreter's start-up and the variant's set-up not counted; its peak (ru_maxrss) holds
+/// Python and the JIT.
+#[derive(clap::Args)]
+pub(crate) struct BenchLoad {
+    /// Triangle counts, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "100000,1000000,4000000")]
+    pub(crate) sizes: Vec<usize>,
+    /// Runs per mesh and loader (alternating); medians are reported.
+    #[arg(long, default_value_t = 3)]
+    pub(crate) runs: usize,
+    /// Where the generated meshes are kept.
+    #[arg(long, default_value = "out/bench/load")]
+    pub(crate) dir: PathBuf,
+    /// Load this scene once and print its times and peak memory (what each run does).
+    #[arg(long, hide = true)]
+    pub(crate) child: Option<PathBuf>,
+}

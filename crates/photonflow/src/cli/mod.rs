@@ -7,7 +7,9 @@ mod rendering;
 mod studies;
 mod tools;
 
-pub(crate) use bench::{BenchAccuracy, BenchKnn, BenchPhotons, BenchRays, BenchSplat, BenchStore};
+pub(crate) use bench::{
+    BenchAccuracy, BenchKnn, BenchLoad, BenchPhotons, BenchRays, BenchSplat, BenchStore,
+};
 pub(crate) use rendering::{Estimate, ImageArgs, Merge, PhotonArgs, Render, Trace};
 pub(crate) use studies::{Evidence, Worksheet};
 pub(crate) use tools::{Compare, Composite, Convert, Info};
@@ -45,6 +47,7 @@ pub(crate) enum Cmd {
     BenchSplat(BenchSplat),
     BenchAccuracy(BenchAccuracy),
     BenchKnn(BenchKnn),
+    BenchLoad(BenchLoad),
     Render(Render),
     Estimate(Estimate),
     Worksheet(Worksheet),

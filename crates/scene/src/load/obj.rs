@@ -7,6 +7,7 @@ use super::Builder;
 use super::faces::{FileErr, Polygons};
 use super::materials::{MTL_KEYS, Source};
 use super::mtl::{convert_mtl, prescan};
+use super::objtext::{self, ObjModel};
 use super::read_regular;
 use super::transform::transform;
 use crate::error::SceneError;
@@ -17,15 +18,18 @@ use std::collections::HashMap;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
-/// An OBJ file as tobj read it, with what its MTL files told.
+/// An OBJ file as `objtext.rs` read it, with what its MTL files told.
 struct Parsed {
-    bytes: Vec<u8>,
-    models: Vec<tobj::Model>,
+    models: Vec<ObjModel>,
     materials: Vec<tobj::Material>,
     /// The `mtllib` names read, in order.
     mtl_files: Vec<String>,
     /// Which MTL file defines which materials: problems name the file at fault.
     defined_in: Vec<(PathBuf, Vec<String>)>,
+    /// The first `usemtl` line of each name, and the number of lines that are neither blank
+    /// nor comments.
+    usemtl: Vec<(usize, String)>,
+    lines: usize,
 }
 
 /// Which material a model's faces take: the mesh's own, or their MTL material's id.
@@ -125,70 +129,66 @@ impl Builder<'_> {
         let mtl_files: RefCell<Vec<String>> = RefCell::new(Vec::new());
         // Which MTL file defines which materials: problems name the file at fault.
         let mtl_of: RefCell<Vec<(PathBuf, Vec<String>)>> = RefCell::new(Vec::new());
-        let loaded = tobj::load_obj_buf(
-            &mut BufReader::new(&bytes[..]),
-            // Faces come whole and are triangulated here (`polygon`): tobj's fan is wrong for
-            // non-convex faces and makes a hopeless BVH of a huge one.
-            &tobj::LoadOptions {
-                triangulate: false,
-                single_index: true,
-                ignore_points: true,
-                ignore_lines: true,
-            },
-            |p| {
-                if !read_mtl {
-                    return Ok(Default::default());
+        // Faces come whole and are triangulated here (`polygon`): a fan is wrong for non-convex
+        // faces and makes a hopeless BVH of a huge one. The text is read on every core, and the
+        // bytes go before the models are formed.
+        let read = objtext::read(&bytes, objtext::CHUNK);
+        drop(bytes);
+        let loaded = objtext::form(read, |p: &Path| {
+            if !read_mtl {
+                return Ok(Default::default());
+            }
+            let mtl_path = obj_dir.join(p);
+            match read_regular(&mtl_path) {
+                Ok(b) => {
+                    mtl_bytes.borrow_mut().extend_from_slice(&b);
+                    mtl_files.borrow_mut().push(p.display().to_string());
+                    let b = match prescan(&b) {
+                        Ok(b) => b,
+                        Err(problem) => {
+                            *mtl_error.borrow_mut() = Some(SceneError::new(
+                                &mtl_path,
+                                format!("malformed MTL file: {problem} ({of})"),
+                            ));
+                            return Err(tobj::LoadError::MaterialParseError);
+                        }
+                    };
+                    tobj::load_mtl_buf(&mut BufReader::new(&b[..]))
+                        .inspect(|(mats, _)| {
+                            let names = mats.iter().map(|m| m.name.clone()).collect();
+                            mtl_of.borrow_mut().push((mtl_path.clone(), names));
+                        })
+                        .inspect_err(|e| {
+                            *mtl_error.borrow_mut() = Some(SceneError::new(
+                                &mtl_path,
+                                format!("malformed MTL file: {e} ({of})"),
+                            ));
+                        })
                 }
-                let mtl_path = obj_dir.join(p);
-                match read_regular(&mtl_path) {
-                    Ok(b) => {
-                        mtl_bytes.borrow_mut().extend_from_slice(&b);
-                        mtl_files.borrow_mut().push(p.display().to_string());
-                        let b = match prescan(&b) {
-                            Ok(b) => b,
-                            Err(problem) => {
-                                *mtl_error.borrow_mut() = Some(SceneError::new(
-                                    &mtl_path,
-                                    format!("malformed MTL file: {problem} ({of})"),
-                                ));
-                                return Err(tobj::LoadError::MaterialParseError);
-                            }
-                        };
-                        tobj::load_mtl_buf(&mut BufReader::new(&b[..]))
-                            .inspect(|(mats, _)| {
-                                let names = mats.iter().map(|m| m.name.clone()).collect();
-                                mtl_of.borrow_mut().push((mtl_path.clone(), names));
-                            })
-                            .inspect_err(|e| {
-                                *mtl_error.borrow_mut() = Some(SceneError::new(
-                                    &mtl_path,
-                                    format!("malformed MTL file: {e} ({of})"),
-                                ));
-                            })
-                    }
-                    Err(e) => {
-                        *mtl_error.borrow_mut() = Some(SceneError::new(
-                            &mtl_path,
-                            format!(
-                                "cannot read MTL file named by `mtllib` in {}: {e} ({of})",
-                                obj_path.display()
-                            ),
-                        ));
-                        Err(tobj::LoadError::OpenFileFailed)
-                    }
+                Err(e) => {
+                    *mtl_error.borrow_mut() = Some(SceneError::new(
+                        &mtl_path,
+                        format!(
+                            "cannot read MTL file named by `mtllib` in {}: {e} ({of})",
+                            obj_path.display()
+                        ),
+                    ));
+                    Err(tobj::LoadError::OpenFileFailed)
                 }
-            },
-        );
+            }
+        });
         if let Some(e) = mtl_error.into_inner() {
             return Err(e);
         }
         self.hash.write(&mtl_bytes.into_inner());
-        let (models, materials) = loaded.map_err(|e| oerr(format!("malformed OBJ file: {e}")))?;
-        let materials =
-            materials.map_err(|e| oerr(format!("its materials failed to load: {e}")))?;
+        let text = loaded.map_err(|e| oerr(format!("malformed OBJ file: {e}")))?;
+        let materials = text
+            .materials
+            .map_err(|e| oerr(format!("its materials failed to load: {e}")))?;
         Ok(Parsed {
-            bytes,
-            models,
+            models: text.models,
+            usemtl: text.usemtl,
+            lines: text.lines,
             materials,
             mtl_files: mtl_files.into_inner(),
             defined_in: mtl_of.into_inner(),
@@ -281,14 +281,14 @@ impl Builder<'_> {
     /// (`faces.rs`) under its material.
     fn append_model(
         &mut self,
-        model: &tobj::Model,
+        model: &ObjModel,
         desc: &MeshDesc,
         xf: DMat4,
         faces: &Faces,
         obj_path: &Path,
         oerr: ObjErr,
     ) -> Result<(), SceneError> {
-        let m = &model.mesh;
+        let m = model;
         if m.indices.is_empty() {
             return Ok(());
         }
@@ -330,14 +330,14 @@ impl Builder<'_> {
 /// model without a material id); a file without faces is refused.
 fn check_faces(parsed: &Parsed, materials_used: bool, oerr: ObjErr) -> Result<(), SceneError> {
     let Parsed {
-        bytes,
         models,
         materials,
         mtl_files,
+        usemtl,
+        lines,
         ..
     } = parsed;
-    let directives = obj_directives(bytes);
-    for (line, name) in &directives.usemtl {
+    for (line, name) in usemtl {
         if !materials_used || materials.iter().any(|m| &m.name == name) {
             continue;
         }
@@ -363,40 +363,12 @@ fn check_faces(parsed: &Parsed, materials_used: bool, oerr: ObjErr) -> Result<()
             )
         }));
     }
-    if models.iter().all(|m| m.mesh.indices.is_empty()) {
-        return Err(oerr(if directives.lines == 0 {
+    if models.iter().all(|m| m.indices.is_empty()) {
+        return Err(oerr(if *lines == 0 {
             "the OBJ file is empty: no vertices, no faces".to_string()
         } else {
             "the OBJ file holds no faces (no `f` line)".to_string()
         }));
     }
     Ok(())
-}
-
-/// An OBJ file's `usemtl` lines (1-based line number, material name, first use of each name)
-/// and its number of non-blank, non-comment lines, read as tobj reads them.
-struct ObjDirectives {
-    usemtl: Vec<(usize, String)>,
-    lines: usize,
-}
-
-fn obj_directives(bytes: &[u8]) -> ObjDirectives {
-    let mut d = ObjDirectives {
-        usemtl: Vec::new(),
-        lines: 0,
-    };
-    for (i, line) in String::from_utf8_lossy(bytes).lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        d.lines += 1;
-        if line.split_whitespace().next() == Some("usemtl") {
-            let name = line.split_once(' ').unwrap_or_default().1.trim();
-            if !name.is_empty() && !d.usemtl.iter().any(|(_, n)| n == name) {
-                d.usemtl.push((i + 1, name.to_string()));
-            }
-        }
-    }
-    d
 }
