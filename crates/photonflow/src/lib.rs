@@ -268,6 +268,7 @@ fn evidence(a: cli::Evidence) -> Result<(), String> {
         budget_scale,
         only,
         out,
+        cache,
         threads,
     } = a;
     lab::evidence(&lab::evidence::EvidenceArgs {
@@ -288,6 +289,7 @@ fn evidence(a: cli::Evidence) -> Result<(), String> {
         budget_scale,
         only,
         out,
+        cache,
         threads,
     })
 }
