@@ -311,12 +311,26 @@ impl Staged {
         )
     }
 
-    /// Renames it into place, replacing the directory there.
+    /// Renames it into place, replacing the directory there. The old one, set aside, is
+    /// removed; where part of it cannot be (a read-only mount inside it), a warning names it
+    /// and the OS error: the new directory is whole all the same.
     pub fn publish(self) -> Result<(), String> {
         check_layout(&self.out, &self.layout)?;
-        self.tmp
+        let stuck = self
+            .tmp
             .replace(&self.out)
-            .map_err(|e| format!("{}: cannot rename into place: {e}", self.out.display()))
+            .map_err(|e| format!("{}: cannot rename into place: {e}", self.out.display()))?;
+        if let Some(s) = stuck {
+            eprintln!(
+                "warning: {}: the directory it replaced, set aside as {}, cannot be removed: \
+                 {} (a later run into {} removes it once it can)",
+                self.out.display(),
+                s.path.display(),
+                s.error,
+                self.out.display()
+            );
+        }
+        Ok(())
     }
 }
 

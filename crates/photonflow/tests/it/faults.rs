@@ -2,8 +2,8 @@
 //! `evidence` (the output directory complete or absent, the photon cache only whole sets and
 //! the reference cache only whole runs, the rerun's images the uninterrupted run's bit for
 //! bit) and part way through `bench-accuracy` (its last whole directory kept); a disk that
-//! fills during a run and an output place that cannot be written (one line naming the path
-//! and the OS error, nothing half written, the cache still good).
+//! fills during a run and an output place that cannot be written, wholly or in part (one
+//! line naming the path and the OS error, nothing half written, the cache still good).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -654,4 +654,124 @@ fn a_killed_bench_accuracy_leaves_its_last_whole_directory() {
     );
     let beside = temps_in(&work.0);
     assert!(beside.is_empty(), "kept {beside:?}");
+}
+
+/// Makes `dir` a read-only bind mount of itself (the rest of its filesystem stays writable);
+/// `None` as [`tmpfs`] says.
+fn read_only(dir: &Path) -> Option<Mount> {
+    let run = |args: &[&str]| {
+        Command::new("mount")
+            .args(args)
+            .arg(dir)
+            .output()
+            .map_err(|e| format!("cannot run mount: {e}"))
+            .and_then(|o| {
+                o.status
+                    .success()
+                    .then_some(())
+                    .ok_or_else(|| String::from_utf8_lossy(&o.stderr).trim().to_string())
+            })
+    };
+    let why = match run(&["--bind", dir.to_str().unwrap()]) {
+        Ok(()) => {
+            let m = Mount(dir.to_path_buf());
+            match run(&["-o", "remount,bind,ro"]) {
+                Ok(()) => return Some(m),
+                Err(e) => e,
+            }
+        }
+        Err(e) => e,
+    };
+    let why = format!("cannot bind {} read-only: {why}", dir.display());
+    assert!(
+        std::env::var_os("PHOTONFLOW_REQUIRE_FAULTS").is_none(),
+        "PHOTONFLOW_REQUIRE_FAULTS is set: {why}"
+    );
+    println!("skipped: {why}");
+    None
+}
+
+/// Whether `dir` holds a whole run directory: `image.json` and every file it implies (the
+/// images, the resolved scene, each layer it lists). Returns the run's method.
+fn whole_run(dir: &Path) -> Option<String> {
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("image.json")).ok()?).ok()?;
+    let files = ["image.exr", "image.png", "scene.toml"];
+    let layers = json["layers"]
+        .as_object()?
+        .keys()
+        .map(|name| dir.join("layers").join(format!("{name}.exr")));
+    let all = files.iter().map(|f| dir.join(f)).chain(layers);
+    all.into_iter()
+        .all(|p| p.is_file())
+        .then(|| json["method"].as_str().unwrap_or("?").to_string())
+}
+
+/// A run directory part of which cannot be written (its `layers/` a read-only mount, the rest
+/// writable) is replaced whole, or kept whole: never the old run without its `image.json`
+/// (runs used to remove the old `image.json` and `scene.toml` first, then fail on the
+/// layers). The new run is published; the old one, set aside, cannot be removed, which one
+/// warning line says, naming it and the OS error; once it can be, the next run removes it.
+#[test]
+fn a_run_directory_partly_read_only_is_replaced_whole() {
+    let work = Work::new("partly");
+    let small = scene(&work.0, 16);
+    let cache = work.0.join("cache");
+    let out = work.0.join("run");
+    let path = |p: &Path| p.to_str().unwrap().to_string();
+    let render = |method: &str| {
+        photonflow(
+            &[
+                "render",
+                &small,
+                "--method",
+                method,
+                "--photons",
+                "5000",
+                "--threads",
+                "1",
+                "--cache",
+                &path(&cache),
+                "--out",
+                &path(&out),
+            ]
+            .map(String::from),
+        )
+    };
+    let o = render("sppm");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let Some(mount) = read_only(&out.join("layers")) else {
+        return;
+    };
+    let o = render("final-gather");
+    let e = String::from_utf8_lossy(&o.stderr);
+    // The mount moved with the old run directory set aside: unmount it there.
+    let aside = temps_in(&work.0);
+    let moved: Vec<Mount> = aside
+        .iter()
+        .map(|a| Mount(work.0.join(a).join("layers")))
+        .collect();
+    drop(mount);
+    assert!(!e.contains("panicked"), "{e}");
+    assert_eq!(o.status.code(), Some(0), "{e}");
+    assert_eq!(
+        whole_run(&out).as_deref(),
+        Some("final-gather"),
+        "{} is not a whole run: {:?}",
+        out.display(),
+        tree(&out).keys()
+    );
+    assert_eq!(aside.len(), 1, "{aside:?}");
+    let warning: Vec<&str> = e.lines().filter(|l| l.starts_with("warning:")).collect();
+    assert_eq!(warning.len(), 1, "{e}");
+    assert!(
+        warning[0].contains(&path(&work.0.join(&aside[0])))
+            && warning[0].contains("Read-only file system"),
+        "{}",
+        warning[0]
+    );
+    drop(moved);
+    let o = render("final-gather");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(temps_in(&work.0), Vec::<String>::new());
 }
