@@ -389,7 +389,7 @@ fn run_peer(
 
 /// `bench accuracy`: every case at every budget, photonflow's methods and the peers taking
 /// turns (each peer warmed up first), then each case's tables and what each peer ran, printed
-/// and in `dir/tables.md`; `dir` is published whole when every case is done.
+/// and in a file `tables.md` in `dir`, which is published whole when every case is done.
 pub fn accuracy(
     cases: &[Case],
     budgets: &[f64],
