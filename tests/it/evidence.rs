@@ -196,6 +196,7 @@ fn the_report_links_resolve_and_a_browser_shows_its_images() {
         budget_scale: 0.02,
         only: Vec::new(),
         out: out.clone(),
+        cache: dir.path().join("cache"),
         threads: None,
     })
     .unwrap_or_else(|e| panic!("{e}"));

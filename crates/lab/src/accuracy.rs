@@ -388,7 +388,8 @@ fn run_peer(
 }
 
 /// `bench accuracy`: every case at every budget, photonflow's methods and the peers taking
-/// turns (each peer warmed up first), then each case's tables and what each peer ran.
+/// turns (each peer warmed up first), then each case's tables and what each peer ran, printed
+/// and in a file `tables.md` in `dir`, which is published whole when every case is done.
 pub fn accuracy(
     cases: &[Case],
     budgets: &[f64],
@@ -425,24 +426,57 @@ pub fn accuracy(
             render::read_reference(&scene, half)?;
         }
     }
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    // The directory is written whole beside its place and renamed into it at the end: a
+    // stopped run (an error, a signal, kill -9) leaves the last whole one, never a mix.
+    let staged = render::output::stage_as(dir, &LAYOUT)?;
+    let tables = measure(cases, budgets, methods, peers, threads, staged.path())
+        .map_err(|e| staged.named(e))?;
+    let file = staged.path().join(TABLES);
+    film::write_atomic(&file, tables.as_bytes()).map_err(|e| staged.named(e.to_string()))?;
+    staged.publish()?;
+    println!("\nwrote {}", dir.join(TABLES).display());
+    Ok(())
+}
+
+/// What a `bench accuracy` directory holds: a directory per case (photonflow's run
+/// directories, the peers' images, the reference halves' mean) and every case's tables.
+pub const LAYOUT: render::output::Layout = render::output::Layout {
+    what: "a bench accuracy directory",
+    flag: "--dir",
+    holds: |name| name == TABLES || name == "cache" || name.starts_with("case-"),
+};
+
+/// The tables of every case, as printed.
+const TABLES: &str = "tables.md";
+
+/// Every case measured into `dir`; returns the tables, which it also prints.
+fn measure(
+    cases: &[Case],
+    budgets: &[f64],
+    methods: &[Method],
+    peers: &[Peer],
+    threads: Option<usize>,
+    dir: &Path,
+) -> Result<String, String> {
     // Peers run from anywhere: give them absolute paths.
     let abs = std::fs::canonicalize(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let cache = dir.join("cache");
+    let mut all = String::new();
     for (k, case) in cases.iter().enumerate() {
         let scene = Scene::load(&case.scene).map_err(|e| e.to_string())?;
         let scene_abs = std::fs::canonicalize(&case.scene)
             .map_err(|e| format!("{}: {e}", case.scene.display()))?;
         let case_dir = abs.join(format!("case-{k}"));
         let scoring = Scoring {
-            halves: crate::reference::halves(
-                &scene,
-                &case.reference_a,
-                &case.reference_b,
-                &case_dir.join("reference-halves-mean.exr"),
-            )?,
+            halves: crate::reference::halves(&scene, &case.reference_a, &case.reference_b)?,
             mask: mask(&scene, case.pixels),
         };
+        std::fs::create_dir(&case_dir).map_err(|e| format!("{}: {e}", case_dir.display()))?;
+        film::write_exr(
+            case_dir.join("reference-halves-mean.exr"),
+            &scoring.halves.mean,
+        )
+        .map_err(|e| e.to_string())?;
         println!(
             "\n{} ({}, {}x{}), reference halves {} and {}",
             scene.file.name,
@@ -512,23 +546,25 @@ pub fn accuracy(
                 col.cells.push(r);
             }
         }
-        println!(
-            "\n{}, {}x{}: corrected relative MSE (wall seconds)\n",
+        use std::fmt::Write;
+        let mut s = format!(
+            "\n{}, {}x{}: corrected relative MSE (wall seconds)\n\n",
             scene.file.name, scene.camera.width, scene.camera.height
         );
-        print!("{}", tables(budgets, &ours, &theirs));
-        println!(
-            "\nphotonflow: `render --method M --time S` on all cores, photons traced anew per run; \
-             each peer ran once untimed at the smallest budget first (calibrations, caches)."
-        );
+        s += &tables(budgets, &ours, &theirs);
+        s += "\nphotonflow: `render --method M --time S` on all cores, photons traced anew per \
+              run; each peer ran once untimed at the smallest budget first (calibrations, \
+              caches).\n";
         for ((p, col), note) in peers.iter().zip(&theirs).zip(&notes) {
             let failed: Vec<String> = col.cells.iter().filter_map(|c| c.clone().err()).collect();
             let how = note.clone().unwrap_or_else(|| format!("`{}`", p.command));
-            match failed.first() {
-                Some(e) => println!("{}: {how}; – : {e}", p.name),
-                None => println!("{}: {how}", p.name),
-            }
+            let _ = match failed.first() {
+                Some(e) => writeln!(s, "{}: {how}; – : {e}", p.name),
+                None => writeln!(s, "{}: {how}", p.name),
+            };
         }
+        print!("{s}");
+        all += &s;
     }
-    Ok(())
+    Ok(all)
 }

@@ -17,10 +17,12 @@ pub mod worksheet;
 mod tests;
 
 /// `evidence`: the ladders measured ([`evidence::run`]), then the lab report written beside
-/// them ([`report::write`]).
+/// them ([`report::write`]) in a staging directory, renamed whole into `a.out`.
 pub fn evidence(a: &evidence::EvidenceArgs) -> Result<(), String> {
     let m = evidence::run(a)?;
-    report::write(&a.out, &m.evidence, &m.scene, &m.regions)?;
+    report::write(m.staged.path(), &m.evidence, &m.scene, &m.regions)
+        .map_err(|e| m.staged.named(e))?;
+    m.staged.publish()?;
     println!(
         "wrote {} and report.html, evidence.md (tables), evidence.json, maps/, plots/",
         a.out.join("report.md").display()

@@ -1,6 +1,8 @@
 //! The one path-traced reference the studies share (`worksheet`, `evidence`, `bench
 //! accuracy`): a given linear EXR, checked against the scene, or a path-traced image rendered
 //! once into a directory named by what it depends on and reused while those settings hold.
+//! That directory is a run directory, published whole (`render::output::Staged`): one that
+//! exists is complete, whenever a run writing it stopped.
 
 use render::{Overrides, Photons, RenderRequest, Settings};
 use scene::{Method, Scene};
@@ -14,19 +16,13 @@ pub struct Reference {
 }
 
 /// The reference given as two independent halves `a` and `b` (other seeds, one budget), each
-/// checked against `scene`, with their mean written to `mean` (a linear EXR every run
-/// directory's plain errors are measured against).
-pub fn halves(scene: &Scene, a: &Path, b: &Path, mean: &Path) -> Result<film::Halves, String> {
-    let h = film::Halves::new(
+/// checked against `scene`; their mean is what every run's plain errors are measured against.
+pub fn halves(scene: &Scene, a: &Path, b: &Path) -> Result<film::Halves, String> {
+    film::Halves::new(
         &render::read_reference(scene, a)?,
         &render::read_reference(scene, b)?,
     )
-    .map_err(|e| format!("{} and {}: {e}", a.display(), b.display()))?;
-    if let Some(dir) = mean.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    }
-    film::write_exr(mean, &h.mean).map_err(|e| e.to_string())?;
-    Ok(h)
+    .map_err(|e| format!("{} and {}: {e}", a.display(), b.display()))
 }
 
 /// `given`, checked against `scene` before anything is written; else `scene` path-traced at

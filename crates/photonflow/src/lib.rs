@@ -277,6 +277,7 @@ fn evidence(a: cli::Evidence) -> Result<(), String> {
         budget_scale,
         only,
         out,
+        cache,
         threads,
     } = a;
     lab::evidence(&lab::evidence::EvidenceArgs {
@@ -297,6 +298,7 @@ fn evidence(a: cli::Evidence) -> Result<(), String> {
         budget_scale,
         only,
         out,
+        cache,
         threads,
     })
 }

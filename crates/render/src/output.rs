@@ -202,12 +202,41 @@ pub const RUN_FILES: [&str; 7] = [
     "snapshots",
 ];
 
+/// A kind of output directory that is written whole and replaced whole: what it is called in
+/// messages and the names it may hold (anything else there is the user's, and refused).
+#[derive(Clone, Copy)]
+pub struct Layout {
+    /// "a run directory", "an evidence directory", ...
+    pub what: &'static str,
+    /// The flag that names it, for the message that refuses one.
+    pub flag: &'static str,
+    /// Whether a name directly inside belongs to this kind of directory.
+    pub holds: fn(&str) -> bool,
+}
+
+/// A run's output directory ([`RUN_FILES`]).
+pub const RUN: Layout = Layout {
+    what: "a run directory",
+    flag: "--out",
+    holds: |name| RUN_FILES.contains(&name),
+};
+
 /// Refuses `out` unless a run directory may go there: absent, empty, or a run directory
 /// (only [`RUN_FILES`] and temps), which the new one replaces whole. Anything else there
 /// (a directory of the user's, the photon cache) is never removed.
 pub fn check_out(out: &Path) -> Result<(), String> {
+    check_layout(out, &RUN)
+}
+
+/// Refuses `out` unless a directory of `layout` may go there: absent, empty, or holding only
+/// the names `layout` holds and temps (which the new one replaces whole).
+pub fn check_layout(out: &Path, layout: &Layout) -> Result<(), String> {
     if out.file_name().is_none() {
-        return Err(format!("{}: --out needs a directory name", out.display()));
+        return Err(format!(
+            "{}: {} needs a directory name",
+            out.display(),
+            layout.flag
+        ));
     }
     let entries = match std::fs::read_dir(out) {
         Ok(e) => e,
@@ -221,28 +250,36 @@ pub fn check_out(out: &Path) -> Result<(), String> {
         let e = e.map_err(|e| format!("{}: cannot read: {e}", out.display()))?;
         let name = e.file_name();
         let name = name.to_string_lossy();
-        if !RUN_FILES.contains(&name.as_ref()) && temps::owner(&name).is_none() {
+        if !(layout.holds)(&name) && temps::owner(&name).is_none() {
             return Err(format!(
-                "{}: exists and is not a run directory (it holds `{name}`), which a run \
-                 replaces whole; choose another --out",
-                out.display()
+                "{}: exists and is not {} (it holds `{name}`), which a run replaces whole; \
+                 choose another {}",
+                out.display(),
+                layout.what,
+                layout.flag
             ));
         }
     }
     Ok(())
 }
 
-/// A run directory being written: a staging directory beside its place, renamed into it by
-/// [`Staged::publish`] (replacing the old one whole), removed if dropped before (an error,
-/// Ctrl-C); one a killed process left is removed by the next run writing there.
+/// An output directory being written: a staging directory beside its place, renamed into it
+/// by [`Staged::publish`] (replacing the old one whole), removed if dropped before (an
+/// error, Ctrl-C); one a killed process left is removed by the next run writing there.
 pub struct Staged {
     tmp: temps::Temp,
     out: std::path::PathBuf,
+    layout: Layout,
 }
 
 /// Starts writing the run directory `out` ([`check_out`] first).
 pub fn stage(out: &Path) -> Result<Staged, String> {
-    check_out(out)?;
+    stage_as(out, &RUN)
+}
+
+/// Starts writing the directory `out` of `layout` ([`check_layout`] first).
+pub fn stage_as(out: &Path, layout: &Layout) -> Result<Staged, String> {
+    check_layout(out, layout)?;
     let (tmp, stale) = temps::Temp::stage(out).map_err(|e| {
         format!(
             "{}: cannot create a staging directory beside it: {e}",
@@ -255,6 +292,7 @@ pub fn stage(out: &Path) -> Result<Staged, String> {
     Ok(Staged {
         tmp,
         out: out.to_path_buf(),
+        layout: *layout,
     })
 }
 
@@ -264,7 +302,8 @@ impl Staged {
         self.tmp.path()
     }
 
-    /// `e` with the staging directory's path replaced by the run directory's, for a message.
+    /// `e` with the staging directory's path replaced by the published directory's, for a
+    /// message.
     pub fn named(&self, e: String) -> String {
         e.replace(
             &self.tmp.path().display().to_string(),
@@ -272,12 +311,26 @@ impl Staged {
         )
     }
 
-    /// Renames it into place, replacing the run directory there.
+    /// Renames it into place, replacing the directory there. The old one, set aside, is
+    /// removed; where part of it cannot be (a read-only mount inside it), a warning names it
+    /// and the OS error: the new directory is whole all the same.
     pub fn publish(self) -> Result<(), String> {
-        check_out(&self.out)?;
-        self.tmp
+        check_layout(&self.out, &self.layout)?;
+        let stuck = self
+            .tmp
             .replace(&self.out)
-            .map_err(|e| format!("{}: cannot rename into place: {e}", self.out.display()))
+            .map_err(|e| format!("{}: cannot rename into place: {e}", self.out.display()))?;
+        if let Some(s) = stuck {
+            eprintln!(
+                "warning: {}: the directory it replaced, set aside as {}, cannot be removed: \
+                 {} (a later run into {} removes it once it can)",
+                self.out.display(),
+                s.path.display(),
+                s.error,
+                self.out.display()
+            );
+        }
+        Ok(())
     }
 }
 

@@ -143,7 +143,9 @@ impl Temp {
     /// Publishes it as `to`, replacing what is there without a moment when `to` is half of
     /// either: the old one is moved aside ([`Temp::aside`]), this one renamed into place, and
     /// the old one removed. A failed rename puts the old one back (and removes this one).
-    pub fn replace(self, to: &Path) -> io::Result<()> {
+    /// Returns the old one if it could not be removed (a part of it read-only, say): it stays
+    /// under its temp name, for a later run to remove once it can.
+    pub fn replace(self, to: &Path) -> io::Result<Option<Stuck>> {
         let old = match std::fs::symlink_metadata(to) {
             Ok(_) => Some(Temp::aside(to)?),
             Err(e) if e.kind() == io::ErrorKind::NotFound => None,
@@ -155,8 +157,23 @@ impl Temp {
             }
             return Err(e);
         }
-        drop(old);
-        Ok(())
+        Ok(old.and_then(|o| o.remove().err()))
+    }
+
+    /// Removes it now, saying why it could not be (dropping it says nothing).
+    pub fn remove(mut self) -> Result<(), Stuck> {
+        let mut live = live();
+        let removed = match self.kind {
+            Kind::File => std::fs::remove_file(&self.path),
+            Kind::Dir => std::fs::remove_dir_all(&self.path),
+        };
+        live.retain(|(p, _)| *p != self.path);
+        // Whatever is left is no longer this process's to remove.
+        self.published = true;
+        removed.map_err(|error| Stuck {
+            path: self.path.clone(),
+            error,
+        })
     }
 
     /// Renames it to `to` (replacing a file there), after which it is no longer a temp. On
@@ -181,6 +198,13 @@ impl Drop for Temp {
             live.retain(|(p, _)| *p != self.path);
         }
     }
+}
+
+/// A temp that could not be removed, and why.
+#[derive(Debug)]
+pub struct Stuck {
+    pub path: PathBuf,
+    pub error: io::Error,
 }
 
 /// Counts of temps removed.

@@ -167,13 +167,13 @@ fn a_staged_directory_replaces_the_old_one_whole() {
     let (t, stale) = Temp::stage(&target).unwrap();
     assert_eq!(stale.len(), 1, "{stale:?}");
     std::fs::write(t.path().join("a"), b"1").unwrap();
-    t.replace(&target).unwrap();
+    assert!(t.replace(&target).unwrap().is_none());
     assert_eq!(listing(&d.0.join("sub")), ["run"]);
     assert_eq!(listing(&target), ["a"]);
 
     let (t, _) = Temp::stage(&target).unwrap();
     std::fs::write(t.path().join("b"), b"2").unwrap();
-    t.replace(&target).unwrap();
+    assert!(t.replace(&target).unwrap().is_none());
     assert_eq!(listing(&d.0.join("sub")), ["run"]);
     assert_eq!(listing(&target), ["b"]);
 }

@@ -157,6 +157,49 @@ fn cases() -> Vec<Case> {
             words: &["--reference-spp 0"],
             check: absent("out"),
         },
+        // A directory replaced whole by the run must hold nothing of the user's: refused
+        // before anything is rendered (the cached reference included), the file kept.
+        Case {
+            name: "evidence --out holding a file of the user's",
+            files: good(),
+            setup: vec![],
+            prepare: Some(|d| {
+                std::fs::create_dir(d.join("out")).unwrap();
+                std::fs::write(d.join("out/notes.txt"), "mine").unwrap();
+            }),
+            args: "evidence {d}/s.toml --quick --reference-spp 1 --out {d}/out --cache {d}/cache",
+            code: 1,
+            words: &[
+                "/out: exists and is not an evidence directory",
+                "`notes.txt`",
+                "--out",
+            ],
+            check: Some(Box::new(|d: &Path| {
+                assert!(d.join("out/notes.txt").is_file(), "notes.txt removed");
+                assert!(!d.join("cache").exists(), "the reference was rendered");
+            })),
+        },
+        Case {
+            name: "bench-accuracy --dir holding a file of the user's",
+            files: with(
+                with(good(), "a.exr", Input::Exr(grey(16, 16))),
+                "b.exr",
+                Input::Exr(Image::from_fn(16, 16, |_, _| [0.6; 3])),
+            ),
+            setup: vec![],
+            prepare: Some(|d| {
+                std::fs::create_dir(d.join("out")).unwrap();
+                std::fs::write(d.join("out/notes.txt"), "mine").unwrap();
+            }),
+            args: "bench-accuracy --case {d}/s.toml,{d}/a.exr,{d}/b.exr --budgets 1 --dir {d}/out",
+            code: 1,
+            words: &[
+                "/out: exists and is not a bench accuracy directory",
+                "`notes.txt`",
+                "--dir",
+            ],
+            check: present("out/notes.txt", "mine"),
+        },
         Case {
             name: "bench-accuracy --peer neither built in nor with a command",
             files: good(),

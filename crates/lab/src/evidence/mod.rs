@@ -35,13 +35,45 @@ pub struct EvidenceArgs {
     pub budget_scale: f64,
     /// Only these techniques (their names' slugs, `k-sweep` for the sweep); empty: all.
     pub only: Vec<String>,
+    /// The report's directory, written whole in a staging directory beside it and renamed
+    /// into place.
     pub out: PathBuf,
+    /// Where the path-traced reference is cached, apart from `out`: a run replaces `out`
+    /// whole, and a reference rendered before a kill must serve the next run.
+    pub cache: PathBuf,
     pub threads: Option<usize>,
 }
 
-/// The reference (`accuracy::reference`: given, or path-traced once and cached in `out`),
+/// What an evidence directory holds: the report and its files (the whole list, so that
+/// a directory of the user's is refused, not replaced).
+pub const EVIDENCE_FILES: [&str; 9] = [
+    "report.md",
+    "report.html",
+    "evidence.md",
+    "evidence.json",
+    "maps",
+    "images",
+    "plots",
+    "reference-halves-mean.exr",
+    // The photon sets of a run that an earlier version kept here.
+    "cache",
+];
+
+/// The mean of a reference given as two halves, in the evidence directory.
+const HALVES_MEAN: &str = "reference-halves-mean.exr";
+
+/// An evidence directory, replaced whole by the next run.
+pub const LAYOUT: render::output::Layout = render::output::Layout {
+    what: "an evidence directory",
+    flag: "--out",
+    // `reference-*`: the path-traced references an earlier version cached in it.
+    holds: |name| EVIDENCE_FILES.contains(&name) || name.starts_with("reference-"),
+};
+
+/// The reference (`accuracy::reference`: given, or path-traced once and cached in `cache`),
 /// read and checked against the scene's size, with its caustic layer when it has one (a
-/// path-traced reference does: `layers/caustic.exr` beside the image).
+/// path-traced reference does: `layers/caustic.exr` beside the image). Writes nothing but
+/// the cached reference.
 pub struct Reference {
     pub path: PathBuf,
     pub image: Image,
@@ -55,7 +87,7 @@ fn reference(scene: &Scene, a: &EvidenceArgs) -> Result<Reference, String> {
         scene,
         a.reference.as_deref(),
         a.reference_spp,
-        &a.out,
+        &a.cache,
         a.threads,
     )?
     .exr;
@@ -67,10 +99,10 @@ fn reference(scene: &Scene, a: &EvidenceArgs) -> Result<Reference, String> {
                 b.display()
             ));
         };
-        let mean = a.out.join("reference-halves-mean.exr");
-        let halves = crate::reference::halves(scene, first, b, &mean)?;
+        let halves = crate::reference::halves(scene, first, b)?;
         return Ok(Reference {
-            path: mean,
+            // Written with the report.
+            path: a.out.join(HALVES_MEAN),
             image: halves.mean.clone(),
             caustic: None,
             halves: Some(halves),
@@ -115,8 +147,12 @@ pub struct SweepResult {
     pub photons: u64,
     pub rung: RungResult,
 }
+/// Measures every rung; the report is then written into the returned [`Measured::staged`]
+/// and published ([`crate::evidence`]).
 pub fn run(a: &EvidenceArgs) -> Result<Measured, String> {
     check(a)?;
+    // Before anything is rendered: a directory of the user's is never replaced.
+    render::output::check_layout(&a.out, &LAYOUT)?;
     let scale = |n: u64| ((n as f64 * a.budget_scale).round() as u64).max(1);
     // `--quick` renders fewer pixels, unless a given reference fixes the image's size.
     let shrink = a.quick && a.reference.is_none();
@@ -127,15 +163,22 @@ pub fn run(a: &EvidenceArgs) -> Result<Measured, String> {
     };
     let scene = Scene::load_with(&a.scene, edit).map_err(|e| e.to_string())?;
     // Nothing is written before the reference is known to be usable (a given one is read
-    // and checked first; a cached one is rendered into `out`, which it creates).
+    // and checked first; a path-traced one is rendered into the cache, or found there).
     let reference = reference(&scene, a)?;
+    // The evidence directory is written whole beside `out` (its photon sets too, removed
+    // before it is published), so a stopped run leaves the old one whole.
+    let staged = render::output::stage_as(&a.out, &LAYOUT)?;
+    if let Some(h) = &reference.halves {
+        let mean = staged.path().join(HALVES_MEAN);
+        film::write_exr(&mean, &h.mean).map_err(|e| staged.named(e.to_string()))?;
+    }
     let regions = crate::regions::regions(&scene);
     let caustic_regions: Vec<(&'static str, Mask)> = regions
         .iter()
         .filter(|(n, _)| matches!(*n, "image" | "caustic"))
         .cloned()
         .collect();
-    let traces = Traces::new(a.out.join("cache"));
+    let traces = Traces::new(staged.path().join("cache"));
     let make = |seed: u64| {
         Scene::load_with(&a.scene, |f| {
             f.seed = seed;
@@ -233,10 +276,12 @@ pub fn run(a: &EvidenceArgs) -> Result<Measured, String> {
             &mut ev,
         )?;
     }
+    drop(traces);
     Ok(Measured {
         evidence: ev,
         scene,
         regions,
+        staged,
     })
 }
 
@@ -332,11 +377,12 @@ impl Done {
 }
 
 /// What [`run`] measured, for the report: the evidence, the scene it was measured on and the
-/// regions of its image.
+/// regions of its image; and the evidence directory being written.
 pub struct Measured {
     pub evidence: Evidence,
     pub scene: Scene,
     pub regions: Vec<(&'static str, Mask)>,
+    pub staged: render::output::Staged,
 }
 
 /// The worksheet's trade-off itself: the global map shown directly, k swept for each kernel,

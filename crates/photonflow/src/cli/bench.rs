@@ -84,7 +84,8 @@ pub(crate) struct BenchSplat {
 /// In one run, every image is scored by its relative MSE against a reference given as two
 /// independent halves, with the reference's noise taken out; per budget the table gives
 /// the best of each side, their error ratio and photonflow's time to the best peer's
-/// error over the peer's time. Runs and peer images go into --dir.
+/// error over the peer's time. Runs, peer images and the tables (tables.md) go into
+/// --dir, written whole beside it and renamed into place when every case is done.
 ///
 /// `cargo xtask bench accuracy` without --case or --suite runs the suite
 /// scenes/bench-accuracy.toml: the worksheet box and McGuire's CornellBox-Original. Their
@@ -123,7 +124,7 @@ pub(crate) struct BenchAccuracy {
     /// (0: all cores).
     #[arg(long)]
     pub(crate) threads: Option<usize>,
-    /// Where runs and peer images go.
+    /// Where runs, peer images and the tables go (replaced whole).
     #[arg(long, default_value = "out/bench/accuracy")]
     pub(crate) dir: PathBuf,
 }

@@ -45,7 +45,7 @@ pub(crate) struct Worksheet {
 /// The techniques: path, path+splat, the global map shown directly with the box and
 /// Silverman kernels, + the topological test, + boundary correction, final gathering,
 /// SPPM, and the caustic map against splatting on the caustic layer; and the global map's
-/// k swept per kernel (k-sweep). The reference is path-traced (rendered once into --out,
+/// k swept per kernel (k-sweep). The reference is path-traced (rendered once into --cache,
 /// then reused) unless --reference gives any linear EXR.
 ///
 /// For each: relative MSE in two conventions, RMSE, mean ratio, FLIP, and bias² and
@@ -56,15 +56,16 @@ pub(crate) struct Worksheet {
 /// Writes the lab report report.html and report.md into --out (images, crops of the
 /// caustic and corners, bias²/variance maps, SVG plots of error against time and of bias²
 /// and variance against k, per-region bars, the boundary-bias correction measured),
-/// evidence.md and evidence.json. The default run takes about 40 minutes on 2 cores
-/// (measured: 40 min wall, 72 min CPU, reference included); see --quick.
+/// evidence.md and evidence.json. --out is written whole beside its place and renamed into
+/// it: a stopped run leaves the last whole report. The default run takes about 40 minutes
+/// on 2 cores (measured: 40 min wall, 72 min CPU, reference included); see --quick.
 #[derive(clap::Args)]
 pub(crate) struct Evidence {
     /// The scene file (TOML).
     #[arg(default_value = "scenes/cornell-spheres/analytic.toml")]
     pub(crate) scene: PathBuf,
     /// A linear RGB EXR of the same view from any renderer (else a path-traced one,
-    /// rendered once into --out and reused).
+    /// rendered once into --cache and reused).
     #[arg(long)]
     pub(crate) reference: Option<PathBuf>,
     /// The reference's second independent half: errors and bias² against the halves'
@@ -96,9 +97,13 @@ pub(crate) struct Evidence {
     /// `--only path --only k-sweep` runs those two.
     #[arg(long)]
     pub(crate) only: Vec<String>,
-    /// Where the report, its images and the reference go.
+    /// Where the report and its images go (replaced whole).
     #[arg(long, default_value = "out/evidence")]
     pub(crate) out: PathBuf,
+    /// Where the path-traced reference is cached, as
+    /// `reference-<settings hash>-<spp>spp/` (a run directory).
+    #[arg(long, default_value = "out/cache")]
+    pub(crate) cache: PathBuf,
     /// Worker threads (default: all cores).
     #[arg(long, value_parser = parse_threads)]
     pub(crate) threads: Option<usize>,

@@ -1,8 +1,9 @@
-//! Faults the binary must survive: kill -9 at any instant of `trace`, `render` and `merge`
-//! (the run directory complete or absent, the photon cache only whole sets, the rerun's image
-//! the uninterrupted run's bit for bit); a disk that fills during a run and an output place
-//! that cannot be written (one line naming the path and the OS error, nothing half written,
-//! the cache still good).
+//! Faults the binary must survive: kill -9 at any instant of `trace`, `render`, `merge` and
+//! `evidence` (the output directory complete or absent, the photon cache only whole sets and
+//! the reference cache only whole runs, the rerun's images the uninterrupted run's bit for
+//! bit) and part way through `bench-accuracy` (its last whole directory kept); a disk that
+//! fills during a run and an output place that cannot be written, wholly or in part (one
+//! line naming the path and the OS error, nothing half written, the cache still good).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -84,8 +85,34 @@ fn temps_in(dir: &Path) -> Vec<String> {
         .collect()
 }
 
+/// What of an output file two runs of one command must agree on: every byte, except where
+/// it records timings. A run directory's `image.json` and the evidence report's tables, pages
+/// and plots against time hold seconds, so only their presence counts; `evidence.json` counts
+/// with its `seconds` taken out (every error, bias and variance figure stays).
+fn deterministic(name: &str, bytes: &[u8]) -> Option<Vec<u8>> {
+    let file = name.rsplit('/').next().unwrap_or(name);
+    if file == "evidence.json" {
+        fn strip(v: &mut serde_json::Value) {
+            match v {
+                serde_json::Value::Object(m) => {
+                    m.remove("seconds");
+                    m.values_mut().for_each(strip);
+                }
+                serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
+                _ => {}
+            }
+        }
+        let mut v: serde_json::Value = serde_json::from_slice(bytes).ok()?;
+        strip(&mut v);
+        return Some(v.to_string().into_bytes());
+    }
+    let timed = ["image.json", "evidence.md", "report.md", "report.html"].contains(&file)
+        || file.ends_with("-vs-time.svg");
+    (!timed).then(|| bytes.to_vec())
+}
+
 /// `out` is absent or holds what the uninterrupted run's directory `reference` holds: the
-/// same files, the images bit for bit (`image.json` records timings, so only its presence).
+/// same files, each the same in what is [`deterministic`] (images bit for bit).
 fn complete_or_absent(out: &Path, reference: &BTreeMap<String, Vec<u8>>, what: &str) {
     if !out.exists() {
         return;
@@ -94,15 +121,16 @@ fn complete_or_absent(out: &Path, reference: &BTreeMap<String, Vec<u8>>, what: &
     let names = |t: &BTreeMap<String, Vec<u8>>| t.keys().cloned().collect::<Vec<_>>();
     assert_eq!(names(&got), names(reference), "{what}: a partial directory");
     for (name, bytes) in reference {
-        if name.ends_with(".exr") {
-            assert!(got[name] == *bytes, "{what}: {name} differs");
-        }
+        assert!(
+            deterministic(name, &got[name]) == deterministic(name, bytes),
+            "{what}: {name} differs"
+        );
     }
 }
 
 /// Every photon file in `cache` reads whole with its checksums and is the uninterrupted run's
-/// file; other files there are the uninterrupted run's too, or (`temps_allowed`) the temps of
-/// a killed process.
+/// file; other files there (a cached reference's run directory) are the uninterrupted run's
+/// too in what is [`deterministic`], or (`temps_ok`) the temps of a killed process.
 fn cache_valid(cache: &Path, reference: &BTreeMap<String, Vec<u8>>, temps_ok: bool, what: &str) {
     for (name, bytes) in tree(cache) {
         if is_temp(&name) {
@@ -115,7 +143,9 @@ fn cache_valid(cache: &Path, reference: &BTreeMap<String, Vec<u8>>, temps_ok: bo
             r.read_all().unwrap_or_else(|e| panic!("{what}: {e}"));
         }
         assert!(
-            reference.get(&name) == Some(&bytes),
+            reference
+                .get(&name)
+                .is_some_and(|r| deterministic(&name, r) == deterministic(&name, &bytes)),
             "{what}: the cache's {name} is not the uninterrupted run's"
         );
     }
@@ -134,11 +164,13 @@ impl Instants {
     }
 }
 
-/// One command of the harness: what it writes (a run directory `out`, the photon cache).
+/// One command of the harness: what it writes (an output directory `out`, which holds
+/// `whole` once complete; its cache).
 struct Case {
     name: &'static str,
     args: Vec<String>,
     out: Option<PathBuf>,
+    whole: &'static str,
     cache: PathBuf,
 }
 
@@ -174,7 +206,10 @@ fn kill_at_instants(case: &Case, n: usize, instants: &mut Instants) -> Tally {
     let warm = timed();
     let check_rerun = |what: &str| {
         if let Some(out) = &case.out {
-            assert!(out.join("image.json").is_file(), "{what}: no run directory");
+            assert!(
+                out.join(case.whole).is_file(),
+                "{what}: no output directory"
+            );
             complete_or_absent(out, &out_ref, what);
             let beside = temps_in(out.parent().unwrap());
             assert!(beside.is_empty(), "{what}: kept {beside:?}");
@@ -220,8 +255,9 @@ fn kill_at_instants(case: &Case, n: usize, instants: &mut Instants) -> Tally {
     tally
 }
 
-/// kill -9 at 60 instants of `trace`, `render` (SPPM, path+splat, final gathering, each
-/// tracing into its photon cache) and `merge`, each followed by the same command again.
+/// kill -9 at 72 instants of `trace`, `render` (SPPM, path+splat, final gathering, each
+/// tracing into its photon cache), `merge` and `evidence` (rendering its reference into its
+/// cache), each followed by the same command again.
 #[cfg(unix)]
 #[test]
 fn kill_9_at_any_instant_leaves_whole_outputs_and_a_good_cache() {
@@ -271,6 +307,7 @@ fn kill_9_at_any_instant_leaves_whole_outputs_and_a_good_cache() {
             &path(&cache),
         ]),
         out: None,
+        whole: "",
         cache: cache.clone(),
     }];
     for (name, method, budget) in [
@@ -283,6 +320,7 @@ fn kill_9_at_any_instant_leaves_whole_outputs_and_a_good_cache() {
             name,
             args,
             out: Some(out),
+            whole: "image.json",
             cache: cache.clone(),
         });
     }
@@ -291,8 +329,43 @@ fn kill_9_at_any_instant_leaves_whole_outputs_and_a_good_cache() {
         name: "merge",
         args: s(&["merge", &path(&shard), "--out", &path(&merged)]),
         out: Some(merged),
+        whole: "image.json",
         // The merge of image shards reads no photons: an empty place.
         cache: work.0.join("no-cache"),
+    });
+    // Its quickest form: a 16-spp reference, two seeds, three techniques (the path tracer,
+    // a global map and the caustic map, whose photon sets it traces into its directory) at
+    // a fiftieth of `--quick`'s budgets; the report, maps and plots as a full run has them.
+    let evidence = runs.join("evidence");
+    let references = work.0.join("references");
+    cases.push(Case {
+        name: "evidence",
+        args: s(&[
+            "evidence",
+            &scene,
+            "--quick",
+            "--seeds",
+            "2",
+            "--reference-spp",
+            "16",
+            "--budget-scale",
+            "0.02",
+            "--only",
+            "path",
+            "--only",
+            "global-map-box",
+            "--only",
+            "caustic-map-k-nn",
+            "--threads",
+            "1",
+            "--cache",
+            &path(&references),
+            "--out",
+            &path(&evidence),
+        ]),
+        out: Some(evidence),
+        whole: "report.html",
+        cache: references,
     });
 
     let mut instants = Instants(0x9e37_79b9_7f4a_7c15);
@@ -315,7 +388,11 @@ struct Mount(PathBuf);
 
 impl Drop for Mount {
     fn drop(&mut self) {
-        let _ = Command::new("umount").arg(&self.0).status();
+        // A mount moved away with the directory that held it is unmounted where it went.
+        let _ = Command::new("umount")
+            .arg(&self.0)
+            .stderr(Stdio::null())
+            .status();
     }
 }
 
@@ -499,4 +576,206 @@ fn a_read_only_output_place_is_one_line_and_keeps_what_is_there() {
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{e}");
     assert!(!e.contains("photons: traced"), "traced again: {e}");
+}
+
+/// `bench-accuracy` killed (kill -9) part way, after it rendered a case's first runs: its
+/// directory is the last whole run's, every file bit for bit (the runs' `image.json` record
+/// their seconds, so a directory written in place would differ), the tables included; the
+/// next run replaces it whole and leaves nothing beside it.
+#[cfg(unix)]
+#[test]
+fn a_killed_bench_accuracy_leaves_its_last_whole_directory() {
+    use std::os::unix::process::ExitStatusExt;
+    let work = Work::new("bench");
+    let scene = scene(&work.0, 16);
+    let path = |p: &Path| p.to_str().unwrap().to_string();
+    let half = |name: &str, v: f32| {
+        let p = work.0.join(name);
+        film::write_exr(&p, &film::Image::from_fn(16, 16, |_, _| [v; 3])).unwrap();
+        path(&p)
+    };
+    let (a, b) = (half("a.exr", 0.5), half("b.exr", 0.6));
+    let dir = work.0.join("accuracy");
+    // A peer that copies a half to $OUT; with `$KILL` set, its runs after the warm-up kill
+    // the bench (the shell's parent) instead.
+    let mark = work.0.join("warmed-up");
+    let peer = format!(
+        "copy=if [ -n \"$KILL\" ] && [ -e '{m}' ]; then kill -9 $PPID; exit 1; fi; touch '{m}'; \
+         cp '{a}' \"$OUT\"",
+        m = path(&mark)
+    );
+    let run = |kill: bool| {
+        let _ = std::fs::remove_file(&mark);
+        let mut c = Command::new(env!("CARGO_BIN_EXE_photonflow"));
+        c.args(["bench-accuracy", "--case"])
+            .arg(format!("{scene},{a},{b}"))
+            .args([
+                "--methods",
+                "path",
+                "--budgets",
+                "0.05,0.1",
+                "--threads",
+                "1",
+            ])
+            .args(["--peer", &peer, "--dir", &path(&dir)]);
+        if kill {
+            c.env("KILL", "1");
+        }
+        c.output().unwrap()
+    };
+    let o = run(false);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let whole = tree(&dir);
+    let complete = |t: &BTreeMap<String, Vec<u8>>| {
+        for f in [
+            "tables.md",
+            "case-0/path-0.05s/image.json",
+            "case-0/peer-copy-0.1s.exr",
+        ] {
+            assert!(t.contains_key(f), "no {f}: {:?}", t.keys());
+        }
+    };
+    complete(&whole);
+    let o = run(true);
+    assert_eq!(
+        o.status.signal(),
+        Some(9),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        tree(&dir) == whole,
+        "the killed run changed {}",
+        dir.display()
+    );
+    let o = run(false);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let again = tree(&dir);
+    complete(&again);
+    assert_ne!(
+        again["case-0/path-0.05s/image.json"],
+        whole["case-0/path-0.05s/image.json"]
+    );
+    let beside = temps_in(&work.0);
+    assert!(beside.is_empty(), "kept {beside:?}");
+}
+
+/// Makes `dir` a read-only bind mount of itself (the rest of its filesystem stays writable);
+/// `None` as [`tmpfs`] says.
+fn read_only(dir: &Path) -> Option<Mount> {
+    let run = |args: &[&str]| {
+        Command::new("mount")
+            .args(args)
+            .arg(dir)
+            .output()
+            .map_err(|e| format!("cannot run mount: {e}"))
+            .and_then(|o| {
+                o.status
+                    .success()
+                    .then_some(())
+                    .ok_or_else(|| String::from_utf8_lossy(&o.stderr).trim().to_string())
+            })
+    };
+    let why = match run(&["--bind", dir.to_str().unwrap()]) {
+        Ok(()) => {
+            let m = Mount(dir.to_path_buf());
+            match run(&["-o", "remount,bind,ro"]) {
+                Ok(()) => return Some(m),
+                Err(e) => e,
+            }
+        }
+        Err(e) => e,
+    };
+    let why = format!("cannot bind {} read-only: {why}", dir.display());
+    assert!(
+        std::env::var_os("PHOTONFLOW_REQUIRE_FAULTS").is_none(),
+        "PHOTONFLOW_REQUIRE_FAULTS is set: {why}"
+    );
+    println!("skipped: {why}");
+    None
+}
+
+/// Whether `dir` holds a whole run directory: `image.json` and every file it implies (the
+/// images, the resolved scene, each layer it lists). Returns the run's method.
+fn whole_run(dir: &Path) -> Option<String> {
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("image.json")).ok()?).ok()?;
+    let files = ["image.exr", "image.png", "scene.toml"];
+    let layers = json["layers"]
+        .as_object()?
+        .keys()
+        .map(|name| dir.join("layers").join(format!("{name}.exr")));
+    let all = files.iter().map(|f| dir.join(f)).chain(layers);
+    all.into_iter()
+        .all(|p| p.is_file())
+        .then(|| json["method"].as_str().unwrap_or("?").to_string())
+}
+
+/// A run directory part of which cannot be written (its `layers/` a read-only mount, the rest
+/// writable) is replaced whole, or kept whole: never the old run without its `image.json`
+/// (runs used to remove the old `image.json` and `scene.toml` first, then fail on the
+/// layers). The new run is published; the old one, set aside, cannot be removed, which one
+/// warning line says, naming it and the OS error; once it can be, the next run removes it.
+#[test]
+fn a_run_directory_partly_read_only_is_replaced_whole() {
+    let work = Work::new("partly");
+    let small = scene(&work.0, 16);
+    let cache = work.0.join("cache");
+    let out = work.0.join("run");
+    let path = |p: &Path| p.to_str().unwrap().to_string();
+    let render = |method: &str| {
+        photonflow(
+            &[
+                "render",
+                &small,
+                "--method",
+                method,
+                "--photons",
+                "5000",
+                "--threads",
+                "1",
+                "--cache",
+                &path(&cache),
+                "--out",
+                &path(&out),
+            ]
+            .map(String::from),
+        )
+    };
+    let o = render("sppm");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let Some(mount) = read_only(&out.join("layers")) else {
+        return;
+    };
+    let o = render("final-gather");
+    let e = String::from_utf8_lossy(&o.stderr);
+    // The mount moved with the old run directory set aside: unmount it there.
+    let aside = temps_in(&work.0);
+    let moved: Vec<Mount> = aside
+        .iter()
+        .map(|a| Mount(work.0.join(a).join("layers")))
+        .collect();
+    drop(mount);
+    assert!(!e.contains("panicked"), "{e}");
+    assert_eq!(o.status.code(), Some(0), "{e}");
+    assert_eq!(
+        whole_run(&out).as_deref(),
+        Some("final-gather"),
+        "{} is not a whole run: {:?}",
+        out.display(),
+        tree(&out).keys()
+    );
+    assert_eq!(aside.len(), 1, "{aside:?}");
+    let warning: Vec<&str> = e.lines().filter(|l| l.starts_with("warning:")).collect();
+    assert_eq!(warning.len(), 1, "{e}");
+    assert!(
+        warning[0].contains(&path(&work.0.join(&aside[0])))
+            && warning[0].contains("Read-only file system"),
+        "{}",
+        warning[0]
+    );
+    drop(moved);
+    let o = render("final-gather");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(temps_in(&work.0), Vec::<String>::new());
 }
