@@ -212,3 +212,43 @@ fn the_weights_of_every_strategy_sum_to_one() {
     }
     eprintln!("worst |sum - 1| over 5600 paths: {worst:.2e}");
 }
+
+/// The grid's query visits every point a brute-force scan finds within the radius, each once
+/// (and others only outside it): clustered points (many per cell and per bucket), and a handful whose eight
+/// buckets make the cells around a query collide, at radii from far below to far above their
+/// spacing, queried at points, near them and far.
+#[test]
+fn the_grid_finds_every_point_within_the_radius_once() {
+    let mut rng = Rng::for_index(11, 0);
+    let mut pt = |scale: f32| {
+        let [a, b] = rng.uniform2();
+        Vec3::new(a, b, rng.uniform()) * scale
+    };
+    let points: Vec<Vec3> = (0..3000)
+        .map(|i| if i % 3 == 0 { pt(4.0) } else { pt(0.3) })
+        .collect();
+    let queries: Vec<Vec3> = (0..300).map(|_| pt(5.0) - Vec3::splat(0.5)).collect();
+    for (points, radius) in [&points[..], &points[1..7]]
+        .into_iter()
+        .flat_map(|p| [1e-3f32, 0.02, 0.1, 0.5, 3.0].map(|r| (p, r)))
+    {
+        let grid = crate::Grid::build(points.iter().copied(), radius);
+        for &q in queries.iter().chain(&points[..6]) {
+            let mut found = Vec::new();
+            grid.query(q, |i| found.push(i));
+            let mut sorted = found.clone();
+            sorted.sort_unstable();
+            sorted.dedup();
+            assert_eq!(
+                sorted.len(),
+                found.len(),
+                "a point visited twice at r {radius}"
+            );
+            sorted.retain(|&i| grid.within(q, points[i]));
+            let brute: Vec<usize> = (0..points.len())
+                .filter(|&i| (points[i] - q).length_squared() <= radius * radius)
+                .collect();
+            assert_eq!(sorted, brute, "r {radius}, query {q}");
+        }
+    }
+}
