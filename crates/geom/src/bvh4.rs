@@ -12,13 +12,13 @@
 //! `t >= 1e-4`, and calls the primitive test through a closure one triangle at a time.
 
 use crate::float::{gamma, next_down, next_up};
+use crate::ploc::{self, Work};
 use crate::simd::{F4, Lanes};
 use crate::{Prim, Ray, Sphere, TriMesh};
-use obvhs::bvh2::{
-    Bvh2, leaf_collapser::collapse, node::Bvh2Node, reinsertion::ReinsertionOptimizer,
-};
-use obvhs::ploc::{PlocBuilder, PlocSearchDistance};
+use obvhs::bvh2::{Bvh2, leaf_collapser::collapse, reinsertion::ReinsertionOptimizer};
+use obvhs::ploc::PlocSearchDistance;
 use obvhs::{BvhBuildParams, aabb::Aabb};
+use rayon::prelude::*;
 use std::ops::{Add, Div, Mul, Sub};
 
 /// Child reference: an inner node's index, or a leaf tagged by `LEAF`.
@@ -247,11 +247,11 @@ impl Bvh4 {
     ) -> Option<Bvh4> {
         let n_tri = mesh.len();
         let bvh2 = binary_bvh(mesh, spheres, params)?;
-        let mut b = Builder {
-            bvh2: &bvh2,
+        let nodes = ploc::compact(bvh2);
+        let b = Builder {
+            choice: vec![0; nodes.len()],
+            bvh2: &nodes,
             n_tri: n_tri as u32,
-            mesh,
-            choice: vec![[Choice::Leaf; 4]; bvh2.nodes.len()],
             out: Bvh4 {
                 nodes: Vec::new(),
                 tris: Vec::new(),
@@ -260,11 +260,28 @@ impl Bvh4 {
                 stack_need: 1,
             },
         };
-        b.optimize(0);
-        let (root, depth) = b.emit(0);
-        b.out.root = root;
-        b.out.stack_need = 3 * depth + 1;
-        Some(b.out)
+        let mut out = b.collapse();
+        drop(nodes);
+        // Each block's vertices from the mesh, in parallel: blocks are independent, so the
+        // result does not depend on the thread count.
+        out.tris = out
+            .ids
+            .par_iter()
+            .map(|ids| {
+                let mut tri = Tri4 {
+                    v: [[[0.0; 4]; 3]; 3],
+                };
+                for (l, &id) in ids.iter().enumerate() {
+                    for (j, v) in mesh.vertices(id as usize).iter().enumerate() {
+                        for a in 0..3 {
+                            tri.v[j][a][l] = v[a];
+                        }
+                    }
+                }
+                tri
+            })
+            .collect();
+        Some(out)
     }
 
     /// Closest hit with `0 < t < ray.t_max`.
@@ -486,8 +503,8 @@ enum Choice {
 ///
 /// The steps of obvhs' `build_bvh2` (obvhs 0.4, `bvh2/builder.rs`: PLOC, reinsertion,
 /// collapse, reinsertion) with PLOC's leaves written straight from the mesh, not from a list
-/// of boxes the builder copies (32 bytes a triangle less at the load's peak): the same `Bvh2`,
-/// which `tests.rs` checks against `build_bvh2`.
+/// of boxes the builder copies, and PLOC itself run over lean buffers (`ploc.rs`): the same
+/// `Bvh2`, which `tests/bvh4.rs` checks against `build_bvh2`.
 pub(crate) fn binary_bvh(
     mesh: &TriMesh,
     spheres: &[Sphere],
@@ -499,37 +516,25 @@ pub(crate) fn binary_bvh(
     }
     let mut bvh = Bvh2::zeroed(n);
     bvh.reset_for_reuse(n, Some((0..n as u32).collect()));
-    let mut ploc = PlocBuilder::with_capacity(n);
     let mut total = Aabb::empty();
-    ploc.current_nodes.clear();
-    ploc.current_nodes
-        .extend(prim_boxes(mesh, spheres).enumerate().map(|(i, b)| {
+    let leaves: Vec<Work> = prim_boxes(mesh, spheres)
+        .enumerate()
+        .map(|(i, b)| {
             total.extend(b.min);
             total.extend(b.max);
-            Bvh2Node::new(b, 1, i as u32)
-        }));
+            Work::leaf(b, i as u32)
+        })
+        .collect();
     let (precision, depth) = (params.sort_precision, params.search_depth_threshold);
+    let b = &mut bvh;
     match params.ploc_search_distance {
-        PlocSearchDistance::Minimum => {
-            ploc.build_ploc_from_leaves::<1, false>(&mut bvh, total, precision, depth)
-        }
-        PlocSearchDistance::VeryLow => {
-            ploc.build_ploc_from_leaves::<2, false>(&mut bvh, total, precision, depth)
-        }
-        PlocSearchDistance::Low => {
-            ploc.build_ploc_from_leaves::<6, false>(&mut bvh, total, precision, depth)
-        }
-        PlocSearchDistance::Medium => {
-            ploc.build_ploc_from_leaves::<14, false>(&mut bvh, total, precision, depth)
-        }
-        PlocSearchDistance::High => {
-            ploc.build_ploc_from_leaves::<24, false>(&mut bvh, total, precision, depth)
-        }
-        PlocSearchDistance::VeryHigh => {
-            ploc.build_ploc_from_leaves::<32, false>(&mut bvh, total, precision, depth)
-        }
+        PlocSearchDistance::Minimum => ploc::build::<1>(b, leaves, total, precision, depth),
+        PlocSearchDistance::VeryLow => ploc::build::<2>(b, leaves, total, precision, depth),
+        PlocSearchDistance::Low => ploc::build::<6>(b, leaves, total, precision, depth),
+        PlocSearchDistance::Medium => ploc::build::<14>(b, leaves, total, precision, depth),
+        PlocSearchDistance::High => ploc::build::<24>(b, leaves, total, precision, depth),
+        PlocSearchDistance::VeryHigh => ploc::build::<32>(b, leaves, total, precision, depth),
     }
-    drop(ploc);
     let mut reinsertion = ReinsertionOptimizer::default();
     reinsertion.run(&mut bvh, params.reinsertion_batch_ratio, None);
     // One primitive per leaf: the collapse forms the leaves.
@@ -559,22 +564,57 @@ pub(crate) fn prim_boxes<'a>(
     }))
 }
 
+/// Four choices in four bits each: the variant in two, `k` (at most 3) in the other two.
+fn pack(c: [Choice; 4]) -> u16 {
+    c.iter().enumerate().fold(0, |acc, (i, c)| {
+        let bits = match *c {
+            Choice::Leaf => 0,
+            Choice::Node(k) => 1 | (k << 2),
+            Choice::Split(k) => 2 | (k << 2),
+            Choice::Fewer => 3,
+        };
+        acc | (bits as u16) << (4 * i)
+    })
+}
+
+/// The choice for `i` slots (1 to 4) out of `pack`'s four.
+fn unpack(p: u16, i: usize) -> Choice {
+    let bits = (p >> (4 * (i - 1))) as u8 & 0xf;
+    match bits & 3 {
+        0 => Choice::Leaf,
+        1 => Choice::Node(bits >> 2),
+        2 => Choice::Split(bits >> 2),
+        _ => Choice::Fewer,
+    }
+}
+
 struct Builder<'a> {
-    bvh2: &'a Bvh2,
+    /// The `Bvh2`'s nodes, 32 bytes each.
+    bvh2: &'a [ploc::Node2],
     /// Primitives `0..n_tri` are triangles, the rest spheres.
     n_tri: u32,
-    mesh: &'a TriMesh,
     /// Per Bvh2 node and slot count `i` (index `i - 1`): the choice that reaches the least
     /// SAH cost of the subtree as a forest of at most `i` subtrees. The costs themselves
-    /// travel up the recursion: a node's are read by its parent only.
-    choice: Vec<[Choice; 4]>,
+    /// travel up the recursion: a node's are read by its parent only. Packed by `pack`.
+    choice: Vec<u16>,
     out: Bvh4,
 }
 
 impl Builder<'_> {
+    /// The collapsed BVH: its nodes and its blocks' triangle ids, the blocks' vertices not yet
+    /// written. The choices are freed with the builder.
+    fn collapse(mut self) -> Bvh4 {
+        self.optimize(0);
+        let (root, depth) = self.emit(0);
+        self.out.root = root;
+        self.out.stack_need = 3 * depth + 1;
+        self.out.nodes.shrink_to_fit();
+        self.out.ids.shrink_to_fit();
+        self.out
+    }
+
     fn children(&self, ni: usize) -> Option<(usize, usize)> {
-        let n = &self.bvh2.nodes[ni];
-        (n.prim_count == 0).then(|| (n.first_index as usize, n.first_index as usize + 1))
+        self.bvh2[ni].children()
     }
 
     /// The optimal collapse of a binary BVH into a wide one by dynamic programming over
@@ -583,13 +623,13 @@ impl Builder<'_> {
     /// to `LEAF_MAX` triangles. Returns the subtree's primitive count, whether it holds a
     /// sphere, and its least cost in 1 to 4 slots.
     fn optimize(&mut self, ni: usize) -> (u32, bool, [f64; 4]) {
-        let node = self.bvh2.nodes[ni];
+        let node = self.bvh2[ni];
         let area = node.aabb().half_area() as f64;
         let Some((l, r)) = self.children(ni) else {
-            let p = self.bvh2.primitive_indices[node.first_index as usize];
+            let p = node.prim;
             let is_sphere = p >= self.n_tri;
             let c = area * if is_sphere { COST_SPHERE } else { COST_BLOCK };
-            self.choice[ni] = [Choice::Leaf; 4];
+            self.choice[ni] = pack([Choice::Leaf; 4]);
             return (1, is_sphere, [c; 4]);
         };
         let (nl, sl, cl) = self.optimize(l);
@@ -620,13 +660,13 @@ impl Builder<'_> {
                 (cost[i - 2], Choice::Fewer)
             };
         }
-        self.choice[ni] = choice;
+        self.choice[ni] = pack(choice);
         (count, sphere, cost)
     }
 
     /// The roots of the forest that stands for subtree `ni` in `i` slots.
     fn forest(&self, ni: usize, i: usize, out: &mut Vec<usize>) {
-        match self.choice[ni][i - 1] {
+        match unpack(self.choice[ni], i) {
             Choice::Leaf | Choice::Node(_) => out.push(ni),
             Choice::Fewer => self.forest(ni, i - 1, out),
             Choice::Split(k) => {
@@ -639,7 +679,7 @@ impl Builder<'_> {
 
     fn prims(&self, ni: usize, out: &mut Vec<u32>) {
         match self.children(ni) {
-            None => out.push(self.bvh2.primitive_indices[self.bvh2.nodes[ni].first_index as usize]),
+            None => out.push(self.bvh2[ni].prim),
             Some((l, r)) => {
                 self.prims(l, out);
                 self.prims(r, out);
@@ -650,31 +690,20 @@ impl Builder<'_> {
     /// Emits the subtree under Bvh2 node `ni` as its one-slot choice; returns its reference
     /// and depth in nodes.
     fn emit(&mut self, ni: usize) -> (u32, usize) {
-        let Choice::Node(k) = self.choice[ni][0] else {
+        let Choice::Node(k) = unpack(self.choice[ni], 1) else {
             let mut prims = Vec::new();
             self.prims(ni, &mut prims);
             if prims[0] >= self.n_tri {
                 return (LEAF | SPHERE | (prims[0] - self.n_tri), 0);
             }
-            let first = self.out.tris.len() as u32;
+            // The blocks' triangles only: their vertices are written once the `Bvh2` is gone.
+            let first = self.out.ids.len() as u32;
             for group in prims.chunks(4) {
-                let mut tri = Tri4 {
-                    v: [[[0.0; 4]; 3]; 3],
-                };
-                let mut ids = [0; 4];
-                for l in 0..4 {
-                    let id = group[l.min(group.len() - 1)];
-                    ids[l] = id;
-                    for (j, v) in self.mesh.vertices(id as usize).iter().enumerate() {
-                        for a in 0..3 {
-                            tri.v[j][a][l] = v[a];
-                        }
-                    }
-                }
-                self.out.tris.push(tri);
-                self.out.ids.push(ids);
+                self.out
+                    .ids
+                    .push(std::array::from_fn(|l| group[l.min(group.len() - 1)]));
             }
-            let blocks = self.out.tris.len() as u32 - first;
+            let blocks = self.out.ids.len() as u32 - first;
             assert!(
                 first <= FIRST_MASK,
                 "too many triangles for the BVH4 leaf encoding"
@@ -701,7 +730,7 @@ impl Builder<'_> {
         for (slot, &k) in kids.iter().enumerate() {
             let (c, d) = self.emit(k);
             depth = depth.max(d);
-            let bb = self.bvh2.nodes[k].aabb();
+            let bb = self.bvh2[k].aabb();
             let n = &mut self.out.nodes[idx];
             for a in 0..3 {
                 n.b[2 * a][slot] = bb.min[a];

@@ -18,6 +18,7 @@ mod bounds;
 mod bvh4;
 pub mod float;
 mod mesh;
+mod ploc;
 mod ray;
 mod simd;
 mod sphere;

@@ -107,6 +107,56 @@ impl TriMesh {
     }
 }
 
+impl TriMesh {
+    /// `append`, taking `other`: when it is the larger, `self` is put in front of it instead of
+    /// it being copied behind `self` (a large mesh file loaded after a few small shapes is not
+    /// held twice). The same mesh either way.
+    pub fn append_owned(&mut self, mut other: TriMesh) {
+        if other.positions.len() <= self.positions.len() {
+            self.append(&other);
+            return;
+        }
+        let base = self.positions.len();
+        for t in &mut other.indices {
+            *t = t.map(|i| i + base as u32);
+        }
+        if !self.normals.is_empty() || !other.normals.is_empty() {
+            let front = std::mem::take(&mut self.normals);
+            let front = if front.is_empty() {
+                vec![Vec3::ZERO; base]
+            } else {
+                front
+            };
+            if other.normals.is_empty() {
+                other.normals = vec![Vec3::ZERO; other.positions.len()];
+            }
+            other.normals.splice(0..0, front);
+        }
+        if !self.texcoords.is_empty() || !other.texcoords.is_empty() {
+            let front = std::mem::take(&mut self.texcoords);
+            let front = if front.is_empty() {
+                vec![Vec2::ZERO; base]
+            } else {
+                front
+            };
+            if other.texcoords.is_empty() {
+                other.texcoords = vec![Vec2::ZERO; other.positions.len()];
+            }
+            other.texcoords.splice(0..0, front);
+        }
+        other
+            .positions
+            .splice(0..0, std::mem::take(&mut self.positions));
+        other
+            .indices
+            .splice(0..0, std::mem::take(&mut self.indices));
+        other
+            .materials
+            .splice(0..0, std::mem::take(&mut self.materials));
+        *self = other;
+    }
+}
+
 /// Angle-weighted vertex normals (Thürmer & Wüthrich 1998, "Computing vertex normals from
 /// polygonal facets"): each face adds its unit normal times the corner angle, so normals do
 /// not depend on how a surface is split into triangles. The course's sphere meshes carry no

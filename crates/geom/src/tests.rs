@@ -2,7 +2,7 @@
 //! geometric spheres, and brute force over all primitives.
 
 use crate::{BvhKind, Geometry, Prim, Ray, Sphere, SurfacePoint, TriMesh, smooth_vertex_normals};
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 use math::Rng;
 
 // The BVH4 collapse and SIMD lane tests live in tests/ (one file per module).
@@ -644,6 +644,40 @@ fn triangle_hits_from_the_surface_itself_are_never_behind_the_origin() {
                 let t_exact = n.dot(pd[0] - od) / n.dot(d.as_dvec3());
                 assert!(t_exact > 0.0, "hit at t {t} but the plane is at {t_exact}");
             }
+        }
+    }
+}
+
+#[test]
+fn append_owned_is_append() {
+    let mesh = |n: usize, normals: bool, uv: bool, m: u32| TriMesh {
+        positions: (0..n).map(|i| Vec3::splat(i as f32 + m as f32)).collect(),
+        normals: if normals {
+            vec![Vec3::Y; n]
+        } else {
+            Vec::new()
+        },
+        texcoords: if uv { vec![Vec2::ONE; n] } else { Vec::new() },
+        indices: (0..n as u32 - 2).map(|i| [i, i + 1, i + 2]).collect(),
+        materials: vec![m; n - 2],
+    };
+    for (a_n, a_uv, b_n, b_uv) in [
+        (false, false, false, false),
+        (true, false, false, true),
+        (false, true, true, false),
+        (true, true, true, true),
+    ] {
+        for (na, nb) in [(3, 10), (10, 3), (4, 4)] {
+            let (a, b) = (mesh(na, a_n, a_uv, 1), mesh(nb, b_n, b_uv, 2));
+            let mut copied = a.clone();
+            copied.append(&b);
+            let mut owned = a.clone();
+            owned.append_owned(b);
+            assert_eq!(copied.positions, owned.positions);
+            assert_eq!(copied.normals, owned.normals);
+            assert_eq!(copied.texcoords, owned.texcoords);
+            assert_eq!(copied.indices, owned.indices);
+            assert_eq!(copied.materials, owned.materials);
         }
     }
 }

@@ -108,16 +108,14 @@ impl Builder<'_> {
         if p.indices.iter().any(|&i| i as usize >= nv) {
             return Err(oerr(p.at("face index out of range".to_string())));
         }
-        // All triangles (no arities) or one arity per face.
-        let arities: Box<dyn Iterator<Item = usize>> = if p.arities.is_empty() {
-            Box::new(std::iter::repeat_n(3, p.indices.len() / 3))
-        } else {
-            Box::new(p.arities.iter().map(|&a| a as usize))
-        };
-        let mut start = 0usize;
         let mut triangles = Vec::new();
-        for (f, n) in arities.enumerate() {
-            let f = p.number(f);
+        if p.arities.is_empty() {
+            // Every face a triangle, which `triangulate` would push as it is.
+            triangles = p.indices.as_chunks::<3>().0.to_vec();
+        }
+        let mut start = 0usize;
+        for (f, &n) in p.arities.iter().enumerate() {
+            let (f, n) = (p.number(f), n as usize);
             let Some(face) = p.indices.get(start..start.saturating_add(n)) else {
                 return Err(oerr(p.at(format!("face {f} runs past the index list"))));
             };
@@ -168,7 +166,7 @@ impl Builder<'_> {
         if desc.flip_normals {
             super::shapes::flip(&mut part);
         }
-        self.mesh.append(&part);
+        self.mesh.append_owned(part);
         Ok(())
     }
 }

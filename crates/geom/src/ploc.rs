@@ -1,0 +1,323 @@
+//! obvhs' PLOC (`ploc/mod.rs` of obvhs 0.4, `build_ploc_from_leaves` without its parallel and
+//! rebuild paths) over lean buffers: the same merges in the same order, so the same `Bvh2`
+//! node for node (`tests/bvh4.rs` checks it against `build_bvh2`), at about half the memory.
+//!
+//! obvhs keeps two lists of 48-byte nodes of the primitives' count and a sort buffer for the
+//! whole build, beside the `Bvh2` it fills; at 4M triangles that was 580 MB of scratch at the
+//! load's peak. Here the lists hold 32-byte nodes, the sort buffer is freed once the leaves are
+//! in Morton order, and both lists shrink to each pass's survivors, so scratch and output
+//! together stay near the finished `Bvh2`'s size.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DVec3, Vec3, Vec3A};
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::{Bvh2, DEFAULT_MAX_STACK_DEPTH, node::Bvh2Node};
+use obvhs::ploc::SortPrecision;
+use obvhs::ploc::morton::{morton_encode_u64_unorm, morton_encode_u128_unorm};
+use rdst::{RadixKey, RadixSort};
+
+/// A node awaiting its merge: box, and a leaf's primitive count and first index or an inner
+/// node's 0 and first child (in `Bvh2::nodes`), as in `Bvh2Node`.
+#[derive(Clone, Copy, Default, Pod, Zeroable)]
+#[repr(C, align(16))]
+pub(crate) struct Work {
+    min: Vec3,
+    prim_count: u32,
+    max: Vec3,
+    first_index: u32,
+}
+
+impl Work {
+    pub(crate) fn leaf(b: Aabb, first_index: u32) -> Work {
+        Work {
+            min: b.min.into(),
+            prim_count: 1,
+            max: b.max.into(),
+            first_index,
+        }
+    }
+
+    #[inline(always)]
+    fn aabb(&self) -> Aabb {
+        Aabb::new(Vec3A::from(self.min), Vec3A::from(self.max))
+    }
+
+    #[inline(always)]
+    fn node(&self) -> Bvh2Node {
+        Bvh2Node::new(self.aabb(), self.prim_count, self.first_index)
+    }
+}
+
+/// obvhs' sort keys, the same layout and radix levels, so its sorts order them alike.
+#[derive(Clone, Copy, Pod, Zeroable)]
+#[repr(C)]
+struct Morton64 {
+    code: u64,
+    index: u64,
+}
+
+impl RadixKey for Morton64 {
+    const LEVELS: usize = 8;
+
+    #[inline(always)]
+    fn get_level(&self, level: usize) -> u8 {
+        self.code.get_level(level)
+    }
+}
+
+#[derive(Clone, Copy, Pod, Zeroable)]
+#[repr(C)]
+struct Morton128 {
+    code: u128,
+    index: u64,
+    padding: u64,
+}
+
+impl RadixKey for Morton128 {
+    const LEVELS: usize = 16;
+
+    #[inline(always)]
+    fn get_level(&self, level: usize) -> u8 {
+        self.code.get_level(level)
+    }
+}
+
+/// The leaves in Morton order of their centres (obvhs' `sort_nodes_by_morton`, sequential).
+fn sorted(leaves: &[Work], precision: SortPrecision, scale: DVec3, offset: DVec3) -> Vec<Work> {
+    let center = |w: &Work| w.aabb().center().as_dvec3() * scale + offset;
+    match precision {
+        SortPrecision::U64 => {
+            let mut m: Vec<Morton64> = leaves
+                .iter()
+                .enumerate()
+                .map(|(i, w)| Morton64 {
+                    code: morton_encode_u64_unorm(center(w)),
+                    index: i as u64,
+                })
+                .collect();
+            if m.len() <= 250_000 {
+                m.sort_unstable_by_key(|m| m.code);
+            } else {
+                m.radix_sort_unstable();
+            }
+            m.iter().map(|m| leaves[m.index as usize]).collect()
+        }
+        SortPrecision::U128 => {
+            let mut m: Vec<Morton128> = leaves
+                .iter()
+                .enumerate()
+                .map(|(i, w)| Morton128 {
+                    code: morton_encode_u128_unorm(center(w)),
+                    index: i as u64,
+                    padding: 0,
+                })
+                .collect();
+            if m.len() <= 250_000 {
+                m.sort_unstable_by_key(|m| m.code);
+            } else {
+                m.radix_sort_unstable();
+            }
+            m.iter().map(|m| leaves[m.index as usize]).collect()
+        }
+    }
+}
+
+/// obvhs' `SearchCache`: the costs a node computed for the nodes after it, read back by them.
+struct SearchCache<const D: usize>([[f32; D]; D]);
+
+impl<const D: usize> SearchCache<D> {
+    #[inline]
+    fn back(&self, index: usize, other: usize) -> f32 {
+        self.0[other % D][index % D]
+    }
+
+    #[inline]
+    fn front(&mut self, index: usize, other: usize) -> &mut f32 {
+        &mut self.0[index % D][other % D]
+    }
+
+    fn find_best_node(&mut self, index: usize, nodes: &[Work]) -> i8 {
+        let mut best_node = index;
+        let mut best_cost = f32::INFINITY;
+        let begin = index - D.min(index);
+        let end = (index + D + 1).min(nodes.len());
+        for other in begin..index {
+            let area = self.back(index, other);
+            if area <= best_cost {
+                best_node = other;
+                best_cost = area;
+            }
+        }
+        let our = nodes[index].aabb();
+        for (other, node) in nodes.iter().enumerate().take(end).skip(index + 1) {
+            let cost = our.union(&node.aabb()).half_area();
+            *self.front(index, other) = cost;
+            if cost <= best_cost {
+                best_node = other;
+                best_cost = cost;
+            }
+        }
+        (best_node as i64 - index as i64) as i8
+    }
+}
+
+/// Shrinks `v` to `len`, handing the rest of its allocation back.
+fn shrink<T>(v: &mut Vec<T>, len: usize) {
+    v.truncate(len);
+    if v.capacity() > len + len / 8 {
+        v.shrink_to_fit();
+    }
+}
+
+/// Builds `bvh` (fresh: its primitive indices `0..n`, its nodes unwritten) over `leaves`,
+/// whose boxes bound `total`; obvhs' `build_ploc_from_leaves::<D, false>`.
+pub(crate) fn build<const D: usize>(
+    bvh: &mut Bvh2,
+    leaves: Vec<Work>,
+    total: Aabb,
+    precision: SortPrecision,
+    search_depth_threshold: usize,
+) {
+    let prim_count = leaves.len();
+    if prim_count == 0 {
+        return;
+    }
+    let nodes_count = 2 * prim_count - 1;
+    bvh.nodes.resize(nodes_count, Bvh2Node::default());
+    let mut insert_index = nodes_count;
+    let scale = 1.0 / total.diagonal().as_dvec3();
+    let offset = -total.min.as_dvec3() * scale;
+
+    let mut current = sorted(&leaves, precision, scale, offset);
+    // The unsorted leaves' allocation becomes the next pass's list.
+    let mut next = leaves;
+    let mut merge = vec![0i8; prim_count];
+    let mut cache = SearchCache::<D>([[0.0; D]; D]);
+    let mut depth = 0;
+    let mut count = prim_count;
+    while count > 1 {
+        let merge = &mut merge[..count];
+        if D == 1 || depth < search_depth_threshold {
+            let mut last_cost = f32::INFINITY;
+            for i in 0..count - 1 {
+                let cost = current[i].aabb().union(&current[i + 1].aabb()).half_area();
+                merge[i] = if last_cost < cost { -1 } else { 1 };
+                last_cost = cost;
+            }
+            merge[count - 1] = -1;
+        } else {
+            for (index, best) in merge.iter_mut().enumerate() {
+                *best = cache.find_best_node(index, &current[..count]);
+            }
+        }
+        let mut next_idx = 0;
+        let mut index = 0;
+        while index < count {
+            let offset = merge[index] as i64;
+            let best = (index as i64 + offset) as usize;
+            // Merged only if both name each other.
+            if best as i64 + merge[best] as i64 != index as i64 {
+                next[next_idx] = current[index];
+                next_idx += 1;
+                index += 1;
+                continue;
+            }
+            // Each pair merges once, at its later node.
+            if best > index {
+                index += 1;
+                continue;
+            }
+            let (left, right) = (current[index], current[best]);
+            insert_index -= 2;
+            bvh.nodes[insert_index] = left.node();
+            bvh.nodes[insert_index + 1] = right.node();
+            let b = left.aabb().union(&right.aabb());
+            next[next_idx] = Work {
+                min: b.min.into(),
+                prim_count: 0,
+                max: b.max.into(),
+                first_index: insert_index as u32,
+            };
+            next_idx += 1;
+            if D == 1 && offset == 1 {
+                index += 2;
+            } else {
+                index += 1;
+            }
+        }
+        std::mem::swap(&mut next, &mut current);
+        count = next_idx;
+        shrink(&mut current, count);
+        shrink(&mut next, count);
+        depth += 1;
+    }
+    debug_assert_eq!(insert_index, 1);
+    bvh.nodes[0] = current[0].node();
+    bvh.max_depth = DEFAULT_MAX_STACK_DEPTH.max(depth + 1);
+    bvh.children_are_ordered_after_parents = true;
+}
+
+/// A `Bvh2` node in 32 bytes for the collapse: its box, and an inner node's first child
+/// (the second follows it) or a leaf's primitive.
+#[derive(Clone, Copy, Pod, Zeroable)]
+#[repr(C, align(16))]
+pub(crate) struct Node2 {
+    min: Vec3,
+    /// Inner: the first child. Leaf: `u32::MAX`.
+    first: u32,
+    max: Vec3,
+    /// Leaf: the primitive (not its slot in `primitive_indices`).
+    pub(crate) prim: u32,
+}
+
+impl Node2 {
+    #[inline(always)]
+    pub(crate) fn aabb(&self) -> Aabb {
+        Aabb::new(Vec3A::from(self.min), Vec3A::from(self.max))
+    }
+
+    #[inline(always)]
+    pub(crate) fn children(&self) -> Option<(usize, usize)> {
+        (self.first != u32::MAX).then(|| (self.first as usize, self.first as usize + 1))
+    }
+}
+
+/// Sixteen bytes at sixteen-byte alignment: the unit `compact` moves nodes in.
+#[derive(Clone, Copy, Pod, Zeroable)]
+#[repr(C, align(16))]
+struct Chunk([u32; 4]);
+
+/// `bvh`'s nodes as `Node2`, written over its own node list (a node moves to an earlier
+/// address, over nodes already read) and the list then shrunk: no second list of nodes at any
+/// time, and `bvh`'s other lists freed. Leaves must hold one primitive each.
+pub(crate) fn compact(mut bvh: Bvh2) -> Vec<Node2> {
+    let nodes = std::mem::take(&mut bvh.nodes);
+    let prims = std::mem::take(&mut bvh.primitive_indices);
+    drop(bvh);
+    let len = nodes.len();
+    let mut c: Vec<Chunk> = bytemuck::allocation::cast_vec(nodes);
+    for i in 0..len {
+        let n: Bvh2Node = bytemuck::cast([c[3 * i], c[3 * i + 1], c[3 * i + 2]]);
+        let b = n.aabb();
+        let (first, prim) = if n.prim_count == 0 {
+            (n.first_index, 0)
+        } else {
+            // A leaf's first primitive (the only one); an unreachable node's anything.
+            let p = prims.get(n.first_index as usize);
+            (u32::MAX, p.copied().unwrap_or(u32::MAX))
+        };
+        let out = Node2 {
+            min: b.min.into(),
+            first,
+            max: b.max.into(),
+            prim,
+        };
+        let [x, y]: [Chunk; 2] = bytemuck::cast(out);
+        c[2 * i] = x;
+        c[2 * i + 1] = y;
+    }
+    drop(prims);
+    c.truncate(2 * len);
+    c.shrink_to_fit();
+    bytemuck::allocation::cast_vec(c)
+}
