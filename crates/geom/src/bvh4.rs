@@ -501,7 +501,7 @@ enum Choice {
 /// leaf (the collapse forms the leaves, and keeps spheres out of triangle blocks). `None`
 /// when there is nothing to index.
 ///
-/// The steps of obvhs' `build_bvh2` (obvhs 0.4, `bvh2/builder.rs`: PLOC, reinsertion,
+/// The steps of obvhs' `build_bvh2` (obvhs 0.4, its `bvh2` builder: PLOC, reinsertion,
 /// collapse, reinsertion) with PLOC's leaves written straight from the mesh, not from a list
 /// of boxes the builder copies, and PLOC itself run over lean buffers (`ploc.rs`): the same
 /// `Bvh2`, which `tests/bvh4.rs` checks against `build_bvh2`.

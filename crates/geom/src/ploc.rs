@@ -1,4 +1,4 @@
-//! obvhs' PLOC (`ploc/mod.rs` of obvhs 0.4, `build_ploc_from_leaves` without its parallel and
+//! obvhs' PLOC (the `ploc` module of obvhs 0.4, `build_ploc_from_leaves` without its parallel and
 //! rebuild paths) over lean buffers: the same merges in the same order, so the same `Bvh2`
 //! node for node (`tests/bvh4.rs` checks it against `build_bvh2`), at about half the memory.
 //!

@@ -5,7 +5,7 @@
 //! faces and points and lines ignored (the reader used before, whose rules the scene files
 //! keep): the same models, names, material ids, vertices in the same order, indices, face
 //! arities and errors (tobj's own `LoadError`, so messages are unchanged), whatever the
-//! chunks. `tests/objtext.rs` holds it to tobj on tricky and mutated files.
+//! chunks. `crates/scene/src/tests/objtext.rs` holds it to tobj on tricky and mutated files.
 //!
 //! tobj's rules kept here: a line is split at Unicode whitespace; `#`, unknown keywords and
 //! blank lines are skipped; `v` takes three floats, then a `w` that divides them or three
