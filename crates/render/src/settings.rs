@@ -35,8 +35,8 @@ pub struct EstimateSettings {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct VcmSettings {
-    /// Passes: pass `j` traces new subpaths from streams `(seed, j, i)`; the image is their
-    /// mean. A time budget sets the passes it made.
+    /// Passes: pass `j` traces new subpaths, drawn from scrambled Sobol sequences as functions
+    /// of `(seed, j, i)`; the image is their mean. A time budget sets the passes it made.
     pub passes: u32,
     /// Light subpaths per pass (0: one per pixel). Pixel `i`'s eye path connects to light
     /// path `i`; every light path is joined to the camera and merged.
@@ -98,8 +98,9 @@ impl Default for VcmSettings {
 pub struct LightSettings {
     /// Light paths per pass (0: `[photons] photons`).
     pub photons: u64,
-    /// Passes: pass `j` traces `photons` new paths from streams `(seed, j, i)`; the image is
-    /// their mean. A time budget sets the passes it made.
+    /// Passes: pass `j` traces `photons` new paths, point `i` of the pass's scrambled Sobol
+    /// sequence for path `i` (a function of `(seed, j, i)`); the image is their mean. A time
+    /// budget sets the passes it made.
     pub passes: u32,
 }
 

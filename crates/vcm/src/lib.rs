@@ -29,8 +29,9 @@
 //! (it changes how often a strategy runs, not which paths it can make), so they still sum to
 //! one over the strategies: the estimate is unbiased but for merging's own bias.
 //!
-//! Determinism: light path `i` and the eye path of pixel `i` of pass `j` draw from their own
-//! streams of `(seed, j, i)`, the light vertices keep path order, and the grid visits them in
+//! Determinism: light path `i` of pass `j` is point `i` of the pass's scrambled Sobol
+//! sequence and the eye path of pixel `i` sample `j` of the pixel's (both functions of
+//! `(seed, j, i)` alone), the light vertices keep path order, and the grid visits them in
 //! an order fixed by the vertices, so a pass is a pure function of the scene and `j` for any
 //! split into chunks and any thread count.
 
