@@ -62,98 +62,42 @@ impl TriMesh {
             .fold(Bounds3::EMPTY, |b, &p| b.union_point(p))
     }
 
-    /// Append another mesh, shifting its indices. Normals stay per-vertex: a flat mesh joined
-    /// to a smooth one gets its face normals as vertex normals only if needed, so we keep a
-    /// flag per triangle instead (see `Geometry`). Here: fill missing normals with zero,
-    /// which `Geometry` reads as "use the face normal".
-    pub fn append(&mut self, other: &TriMesh) {
-        let base = self.positions.len() as u32;
-        let self_has = !self.normals.is_empty();
-        let other_has = !other.normals.is_empty();
-        if self_has || other_has {
-            if !self_has {
-                self.normals = vec![Vec3::ZERO; self.positions.len()];
-            }
-            if other_has {
-                self.normals.extend_from_slice(&other.normals);
-            } else {
-                self.normals
-                    .extend(std::iter::repeat_n(Vec3::ZERO, other.positions.len()));
-            }
+    /// Append another mesh, shifting its indices. Normals and texture coordinates stay
+    /// per-vertex: a part without them gets zeros (a zero normal `Geometry` reads as "use the
+    /// face normal"; a part has no texture coordinates when its materials carry no texture, or
+    /// its loader said so). The smaller part is moved into the larger,
+    /// so a large mesh file loaded after a few small shapes is never held twice.
+    pub fn append(&mut self, mut other: TriMesh) {
+        let (n_self, n_other) = (self.positions.len(), other.positions.len());
+        for t in &mut other.indices {
+            *t = t.map(|i| i + n_self as u32);
         }
-        // Texture coordinates likewise: zero where a part has none (its materials carry no
-        // texture, or the loader said so).
-        let self_uv = !self.texcoords.is_empty();
-        let other_uv = !other.texcoords.is_empty();
-        if self_uv || other_uv {
-            if !self_uv {
-                self.texcoords = vec![Vec2::ZERO; self.positions.len()];
-            }
-            if other_uv {
-                self.texcoords.extend_from_slice(&other.texcoords);
-            } else {
-                self.texcoords
-                    .extend(std::iter::repeat_n(Vec2::ZERO, other.positions.len()));
-            }
-        }
-        self.positions.extend_from_slice(&other.positions);
-        self.indices.extend(
-            other
-                .indices
-                .iter()
-                .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
-        );
-        self.materials.extend_from_slice(&other.materials);
+        let s = std::mem::take(self);
+        *self = TriMesh {
+            positions: concat(s.positions, n_self, other.positions, n_other, Vec3::ZERO),
+            normals: concat(s.normals, n_self, other.normals, n_other, Vec3::ZERO),
+            texcoords: concat(s.texcoords, n_self, other.texcoords, n_other, Vec2::ZERO),
+            indices: concat(s.indices, 0, other.indices, 0, [0; 3]),
+            materials: concat(s.materials, 0, other.materials, 0, 0),
+        };
     }
 }
 
-impl TriMesh {
-    /// `append`, taking `other`: when it is the larger, `self` is put in front of it instead of
-    /// it being copied behind `self` (a large mesh file loaded after a few small shapes is not
-    /// held twice). The same mesh either way.
-    pub fn append_owned(&mut self, mut other: TriMesh) {
-        if other.positions.len() <= self.positions.len() {
-            self.append(&other);
-            return;
-        }
-        let base = self.positions.len();
-        for t in &mut other.indices {
-            *t = t.map(|i| i + base as u32);
-        }
-        if !self.normals.is_empty() || !other.normals.is_empty() {
-            let front = std::mem::take(&mut self.normals);
-            let front = if front.is_empty() {
-                vec![Vec3::ZERO; base]
-            } else {
-                front
-            };
-            if other.normals.is_empty() {
-                other.normals = vec![Vec3::ZERO; other.positions.len()];
-            }
-            other.normals.splice(0..0, front);
-        }
-        if !self.texcoords.is_empty() || !other.texcoords.is_empty() {
-            let front = std::mem::take(&mut self.texcoords);
-            let front = if front.is_empty() {
-                vec![Vec2::ZERO; base]
-            } else {
-                front
-            };
-            if other.texcoords.is_empty() {
-                other.texcoords = vec![Vec2::ZERO; other.positions.len()];
-            }
-            other.texcoords.splice(0..0, front);
-        }
-        other
-            .positions
-            .splice(0..0, std::mem::take(&mut self.positions));
-        other
-            .indices
-            .splice(0..0, std::mem::take(&mut self.indices));
-        other
-            .materials
-            .splice(0..0, std::mem::take(&mut self.materials));
-        *self = other;
+/// `front` then `back`, per-vertex values of `n_front` and `n_back` vertices where a part's
+/// empty list stands for `zero` at each of its vertices (empty when both are): the shorter
+/// moved into the longer.
+fn concat<T: Copy>(front: Vec<T>, n_front: usize, back: Vec<T>, n_back: usize, zero: T) -> Vec<T> {
+    if front.is_empty() && back.is_empty() {
+        return Vec::new();
+    }
+    let fill = |v: Vec<T>, n: usize| if v.is_empty() { vec![zero; n] } else { v };
+    let (mut front, mut back) = (fill(front, n_front), fill(back, n_back));
+    if back.len() > front.len() {
+        back.splice(0..0, front);
+        back
+    } else {
+        front.extend_from_slice(&back);
+        front
     }
 }
 

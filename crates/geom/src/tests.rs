@@ -61,7 +61,7 @@ fn uv_sphere(c: Vec3, r: f32, slices: u32, stacks: u32) -> (Vec<Vec3>, Vec<[u32;
 fn mesh_of(parts: &[(Vec<Vec3>, Vec<[u32; 3]>)]) -> TriMesh {
     let mut m = TriMesh::default();
     for (mat, (p, i)) in parts.iter().enumerate() {
-        m.append(&TriMesh {
+        m.append(TriMesh {
             positions: p.clone(),
             normals: vec![],
             indices: i.clone(),
@@ -648,16 +648,23 @@ fn triangle_hits_from_the_surface_itself_are_never_behind_the_origin() {
     }
 }
 
+/// Appending keeps both parts in order: positions, indices shifted past the first part,
+/// materials, and normals and texture coordinates with zeros for a part that has none (none
+/// at all when neither has), whichever part is the larger.
 #[test]
-fn append_owned_is_append() {
+fn append_joins_two_meshes_in_order() {
     let mesh = |n: usize, normals: bool, uv: bool, m: u32| TriMesh {
         positions: (0..n).map(|i| Vec3::splat(i as f32 + m as f32)).collect(),
         normals: if normals {
-            vec![Vec3::Y; n]
+            vec![Vec3::Y * m as f32; n]
         } else {
             Vec::new()
         },
-        texcoords: if uv { vec![Vec2::ONE; n] } else { Vec::new() },
+        texcoords: if uv {
+            vec![Vec2::ONE * m as f32; n]
+        } else {
+            Vec::new()
+        },
         indices: (0..n as u32 - 2).map(|i| [i, i + 1, i + 2]).collect(),
         materials: vec![m; n - 2],
     };
@@ -669,15 +676,47 @@ fn append_owned_is_append() {
     ] {
         for (na, nb) in [(3, 10), (10, 3), (4, 4)] {
             let (a, b) = (mesh(na, a_n, a_uv, 1), mesh(nb, b_n, b_uv, 2));
-            let mut copied = a.clone();
-            copied.append(&b);
-            let mut owned = a.clone();
-            owned.append_owned(b);
-            assert_eq!(copied.positions, owned.positions);
-            assert_eq!(copied.normals, owned.normals);
-            assert_eq!(copied.texcoords, owned.texcoords);
-            assert_eq!(copied.indices, owned.indices);
-            assert_eq!(copied.materials, owned.materials);
+            let mut joined = a.clone();
+            joined.append(b.clone());
+            let or_zeros = |v: &Vec<Vec3>, n: usize| {
+                if v.is_empty() {
+                    vec![Vec3::ZERO; n]
+                } else {
+                    v.clone()
+                }
+            };
+            let uv_or_zeros = |v: &Vec<Vec2>, n: usize| {
+                if v.is_empty() {
+                    vec![Vec2::ZERO; n]
+                } else {
+                    v.clone()
+                }
+            };
+            assert_eq!(
+                joined.positions,
+                [a.positions.clone(), b.positions.clone()].concat()
+            );
+            let normals = if a_n || b_n {
+                [or_zeros(&a.normals, na), or_zeros(&b.normals, nb)].concat()
+            } else {
+                Vec::new()
+            };
+            assert_eq!(joined.normals, normals);
+            let uv = if a_uv || b_uv {
+                [uv_or_zeros(&a.texcoords, na), uv_or_zeros(&b.texcoords, nb)].concat()
+            } else {
+                Vec::new()
+            };
+            assert_eq!(joined.texcoords, uv);
+            let shifted = b.indices.iter().map(|t| t.map(|i| i + na as u32));
+            assert_eq!(
+                joined.indices,
+                a.indices.iter().copied().chain(shifted).collect::<Vec<_>>()
+            );
+            assert_eq!(
+                joined.materials,
+                [a.materials.clone(), b.materials.clone()].concat()
+            );
         }
     }
 }

@@ -53,6 +53,28 @@ fn photonflow(args: &[String]) -> std::process::Output {
         .unwrap()
 }
 
+fn path_str(p: &Path) -> String {
+    p.to_str().unwrap().to_string()
+}
+
+/// `render SCENE --method METHOD EXTRA...` on one thread, its photon sets cached in `cache`,
+/// into `out`.
+fn render_args(scene: &str, method: &str, extra: &[&str], cache: &Path, out: &Path) -> Vec<String> {
+    let mut args: Vec<String> = ["render", scene, "--method", method]
+        .iter()
+        .chain(extra)
+        .map(|a| a.to_string())
+        .collect();
+    args.extend([
+        "--threads".into(),
+        "1".into(),
+        "--cache".into(),
+        path_str(cache),
+    ]);
+    args.extend(["--out".into(), path_str(out)]);
+    args
+}
+
 /// Every file under `dir` (relative paths) with its bytes; an absent `dir` is empty.
 fn tree(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     let mut found = BTreeMap::new();
@@ -266,14 +288,10 @@ fn kill_9_at_any_instant_leaves_whole_outputs_and_a_good_cache() {
     let cache = work.0.join("cache");
     let runs = work.0.join("runs");
     let s = |v: &[&str]| v.iter().map(|a| a.to_string()).collect::<Vec<String>>();
-    let path = |p: &Path| p.to_str().unwrap().to_string();
     let render = |method: &str, budget: &[&str], name: &str| {
         let out = runs.join(name);
-        let mut args = s(&["render", &scene, "--method", method, "--photons", "5000"]);
-        args.extend(s(budget));
-        args.extend(s(&["--threads", "1", "--cache", &path(&cache)]));
-        args.extend(s(&["--out", &path(&out)]));
-        (args, out)
+        let extra = [&["--photons", "5000"], budget].concat();
+        (render_args(&scene, method, &extra, &cache, &out), out)
     };
     // The shard the merge reads, rendered once.
     let shard = work.0.join("shard");
@@ -289,7 +307,7 @@ fn kill_9_at_any_instant_leaves_whole_outputs_and_a_good_cache() {
         "--threads",
         "1",
         "--out",
-        &path(&shard),
+        &path_str(&shard),
     ]));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 
@@ -304,7 +322,7 @@ fn kill_9_at_any_instant_leaves_whole_outputs_and_a_good_cache() {
             "1",
             "--force",
             "--cache",
-            &path(&cache),
+            &path_str(&cache),
         ]),
         out: None,
         whole: "",
@@ -327,7 +345,7 @@ fn kill_9_at_any_instant_leaves_whole_outputs_and_a_good_cache() {
     let merged = runs.join("merged");
     cases.push(Case {
         name: "merge",
-        args: s(&["merge", &path(&shard), "--out", &path(&merged)]),
+        args: s(&["merge", &path_str(&shard), "--out", &path_str(&merged)]),
         out: Some(merged),
         whole: "image.json",
         // The merge of image shards reads no photons: an empty place.
@@ -359,9 +377,9 @@ fn kill_9_at_any_instant_leaves_whole_outputs_and_a_good_cache() {
             "--threads",
             "1",
             "--cache",
-            &path(&references),
+            &path_str(&references),
             "--out",
-            &path(&evidence),
+            &path_str(&evidence),
         ]),
         out: Some(evidence),
         whole: "report.html",
@@ -443,27 +461,9 @@ fn a_full_disk_leaves_no_partial_output_and_a_good_cache() {
     };
     let cache = m.0.join("cache");
     let out = m.0.join("run");
-    let path = |p: &Path| p.to_str().unwrap().to_string();
-    let args = |out: &Path| -> Vec<String> {
-        [
-            "render",
-            &small,
-            "--method",
-            "sppm",
-            "--passes",
-            "4",
-            "--photons",
-            "20000",
-            "--threads",
-            "1",
-            "--cache",
-            &path(&cache),
-            "--out",
-            &path(out),
-        ]
-        .iter()
-        .map(|a| a.to_string())
-        .collect()
+    let args = |out: &Path| {
+        let extra = ["--passes", "4", "--photons", "20000"];
+        render_args(&small, "sppm", &extra, &cache, out)
     };
     // The photon sets first (about 1.5 MB), then the run that fills the disk.
     let trace = [
@@ -474,14 +474,14 @@ fn a_full_disk_leaves_no_partial_output_and_a_good_cache() {
         "--threads",
         "1",
         "--cache",
-        &path(&cache),
+        &path_str(&cache),
     ];
     let o = photonflow(&trace.map(String::from));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let o = photonflow(&args(&out));
     let line = error_line(&o, "a full disk");
     assert!(
-        line.contains(&path(&out)) && line.contains("No space left on device"),
+        line.contains(&path_str(&out)) && line.contains("No space left on device"),
         "{line}"
     );
     assert!(!line.contains(".tmp-"), "names a staging path: {line}");
@@ -521,27 +521,8 @@ fn a_read_only_output_place_is_one_line_and_keeps_what_is_there() {
     let Some(m) = tmpfs(&place, "size=1m") else {
         return;
     };
-    let path = |p: &Path| p.to_str().unwrap().to_string();
     let out = m.0.join("run");
-    let args = |method: &str| -> Vec<String> {
-        [
-            "render",
-            &small,
-            "--method",
-            method,
-            "--photons",
-            "5000",
-            "--threads",
-            "1",
-            "--cache",
-            &path(&cache),
-            "--out",
-            &path(&out),
-        ]
-        .iter()
-        .map(|a| a.to_string())
-        .collect()
-    };
+    let args = |method: &str| render_args(&small, method, &["--photons", "5000"], &cache, &out);
     let o = photonflow(&args("sppm"));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let before = tree(&out);
@@ -558,11 +539,11 @@ fn a_read_only_output_place_is_one_line_and_keeps_what_is_there() {
             out.clone()
         };
         let mut a = args(method);
-        *a.last_mut().unwrap() = path(&target);
+        *a.last_mut().unwrap() = path_str(&target);
         let o = photonflow(&a);
         let line = error_line(&o, what);
         assert!(
-            line.contains(&path(&target)) && line.contains("Read-only file system"),
+            line.contains(&path_str(&target)) && line.contains("Read-only file system"),
             "{what}: {line}"
         );
     }
@@ -570,7 +551,7 @@ fn a_read_only_output_place_is_one_line_and_keeps_what_is_there() {
     assert!(!m.0.join("new").exists());
     let o = photonflow(&{
         let mut a = args("final-gather");
-        *a.last_mut().unwrap() = path(&work.0.join("run"));
+        *a.last_mut().unwrap() = path_str(&work.0.join("run"));
         a
     });
     let e = String::from_utf8_lossy(&o.stderr);
@@ -588,11 +569,10 @@ fn a_killed_bench_accuracy_leaves_its_last_whole_directory() {
     use std::os::unix::process::ExitStatusExt;
     let work = Work::new("bench");
     let scene = scene(&work.0, 16);
-    let path = |p: &Path| p.to_str().unwrap().to_string();
     let half = |name: &str, v: f32| {
         let p = work.0.join(name);
         film::write_exr(&p, &film::Image::from_fn(16, 16, |_, _| [v; 3])).unwrap();
-        path(&p)
+        path_str(&p)
     };
     let (a, b) = (half("a.exr", 0.5), half("b.exr", 0.6));
     let dir = work.0.join("accuracy");
@@ -602,7 +582,7 @@ fn a_killed_bench_accuracy_leaves_its_last_whole_directory() {
     let peer = format!(
         "copy=if [ -n \"$KILL\" ] && [ -e '{m}' ]; then kill -9 $PPID; exit 1; fi; touch '{m}'; \
          cp '{a}' \"$OUT\"",
-        m = path(&mark)
+        m = path_str(&mark)
     );
     let run = |kill: bool| {
         let _ = std::fs::remove_file(&mark);
@@ -617,7 +597,7 @@ fn a_killed_bench_accuracy_leaves_its_last_whole_directory() {
                 "--threads",
                 "1",
             ])
-            .args(["--peer", &peer, "--dir", &path(&dir)]);
+            .args(["--peer", &peer, "--dir", &path_str(&dir)]);
         if kill {
             c.env("KILL", "1");
         }
@@ -722,25 +702,14 @@ fn a_run_directory_partly_read_only_is_replaced_whole() {
     let small = scene(&work.0, 16);
     let cache = work.0.join("cache");
     let out = work.0.join("run");
-    let path = |p: &Path| p.to_str().unwrap().to_string();
     let render = |method: &str| {
-        photonflow(
-            &[
-                "render",
-                &small,
-                "--method",
-                method,
-                "--photons",
-                "5000",
-                "--threads",
-                "1",
-                "--cache",
-                &path(&cache),
-                "--out",
-                &path(&out),
-            ]
-            .map(String::from),
-        )
+        photonflow(&render_args(
+            &small,
+            method,
+            &["--photons", "5000"],
+            &cache,
+            &out,
+        ))
     };
     let o = render("sppm");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -769,7 +738,7 @@ fn a_run_directory_partly_read_only_is_replaced_whole() {
     let warning: Vec<&str> = e.lines().filter(|l| l.starts_with("warning:")).collect();
     assert_eq!(warning.len(), 1, "{e}");
     assert!(
-        warning[0].contains(&path(&work.0.join(&aside[0])))
+        warning[0].contains(&path_str(&work.0.join(&aside[0])))
             && warning[0].contains("Read-only file system"),
         "{}",
         warning[0]

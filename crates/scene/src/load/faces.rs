@@ -166,7 +166,7 @@ impl Builder<'_> {
         if desc.flip_normals {
             super::shapes::flip(&mut part);
         }
-        self.mesh.append_owned(part);
+        self.mesh.append(part);
         Ok(())
     }
 }
