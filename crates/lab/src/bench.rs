@@ -656,6 +656,19 @@ print(f"parse {t2 - t1} build {t3 - t2} total {t3 - t1} peak_kib {resource.getru
 /// One load's figures: parse, build and total seconds, peak MiB.
 type LoadRun = [f64; 4];
 
+/// One load in a fresh process (`who`'s): the figures it prints, or why it gave none.
+fn load_run(child: &mut std::process::Command, who: &str) -> Result<LoadRun, String> {
+    let out = child
+        .output()
+        .map_err(|e| format!("{who}: {:?}: {e}", child.get_program()))?;
+    load_figures(&String::from_utf8_lossy(&out.stdout)).ok_or_else(|| {
+        format!(
+            "{who}'s load failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        )
+    })
+}
+
 /// Reads `parse P build B total T peak_kib K` from a run's output.
 fn load_figures(out: &str) -> Option<LoadRun> {
     let line = out.lines().rev().find(|l| l.starts_with("parse "))?;
@@ -719,37 +732,22 @@ pub fn load(sizes: &[usize], runs: usize, dir: &Path) -> Result<(), String> {
         let mut ours: Vec<LoadRun> = Vec::new();
         let mut theirs: Vec<LoadRun> = Vec::new();
         for _ in 0..runs.max(1) {
-            let out = std::process::Command::new(&exe)
-                .args(["bench-load", "--child"])
-                .arg(&toml)
-                .output()
-                .map_err(|e| e.to_string())?;
-            let text = String::from_utf8_lossy(&out.stdout);
-            ours.push(load_figures(&text).ok_or_else(|| {
-                format!(
-                    "photonflow's load failed: {}",
-                    String::from_utf8_lossy(&out.stderr)
-                )
-            })?);
+            let mut child = std::process::Command::new(&exe);
+            child.args(["bench-load", "--child"]).arg(&toml);
+            ours.push(load_run(&mut child, "photonflow")?);
             if let Some(py) = &python {
-                let out = std::process::Command::new(py)
-                    .arg(&script)
-                    .arg(&obj)
-                    .output()
-                    .map_err(|e| format!("{}: {e}", py.display()))?;
-                let text = String::from_utf8_lossy(&out.stdout);
-                theirs.push(load_figures(&text).ok_or_else(|| {
-                    format!(
-                        "Mitsuba's load failed: {}",
-                        String::from_utf8_lossy(&out.stderr)
-                    )
-                })?);
+                let mut child = std::process::Command::new(py);
+                child.arg(&script).arg(&obj);
+                theirs.push(load_run(&mut child, "Mitsuba")?);
             }
         }
         let median = |runs: &[LoadRun], k: usize| {
             let mut v: Vec<f64> = runs.iter().map(|r| r[k]).collect();
-            v.sort_by(f64::total_cmp);
-            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+            if v.is_empty() {
+                f64::NAN
+            } else {
+                median(&mut v)
+            }
         };
         let ours_m: Vec<f64> = (0..4).map(|k| median(&ours, k)).collect();
         let theirs_m: Vec<f64> = (0..4).map(|k| median(&theirs, k)).collect();
