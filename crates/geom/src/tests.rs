@@ -720,3 +720,50 @@ fn append_joins_two_meshes_in_order() {
         }
     }
 }
+
+/// The branch-free step `offset_origin` uses is `next_up` / `next_down` / identity, against
+/// those two over zeros, subnormals, the largest finite values, infinities and random bit
+/// patterns (NaN excluded: a spawned ray's origin is never NaN).
+#[test]
+fn ulp_step_is_next_up_or_next_down() {
+    use crate::float::{next_down, next_up};
+    use crate::ray::ulp_step;
+    let mut xs = vec![
+        0.0,
+        -0.0,
+        f32::from_bits(1),
+        -f32::from_bits(1),
+        f32::MIN_POSITIVE,
+        -f32::MIN_POSITIVE,
+        f32::MAX,
+        f32::MIN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        1.0,
+        -1.0,
+    ];
+    let mut rng = Rng::new(7);
+    while xs.len() < 100_000 {
+        let x = f32::from_bits(rng.next_u32());
+        if !x.is_nan() {
+            xs.push(x);
+        }
+    }
+    for &x in &xs {
+        for s in [1e-30, 3.0, f32::INFINITY, -1e-30, -3.0, 0.0, -0.0] {
+            let want = if s > 0.0 {
+                next_up(x)
+            } else if s < 0.0 {
+                next_down(x)
+            } else {
+                x
+            };
+            assert_eq!(
+                ulp_step(x, s).to_bits(),
+                want.to_bits(),
+                "x = {x:e} ({:#x}), s = {s}",
+                x.to_bits()
+            );
+        }
+    }
+}
