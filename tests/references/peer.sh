@@ -13,6 +13,9 @@
 # BPY_VENV    cycles only: a Python 3.11 environment with bpy, numpy, OpenEXR
 # PEER_CACHE  where Mitsuba's timing calibration is kept (default: peer-cache beside OUT)
 # THREADS     default 2
+# PEER_SPP    mitsuba, mitsuba-ptracer: render exactly this many spp, SECONDS ignored (no
+#             calibration; `bench path` compares at equal spp)
+# PEER_SEED   mitsuba, mitsuba-ptracer: the sampler's seed (default 7)
 #
 # The scene is converted as make.sh converts it (peer_scene.py). The last line on stdout,
 # `settings: ...`, says what ran; a peer that cannot render the scene exits with status 3 and
@@ -69,10 +72,15 @@ case $peer in
     mi() { # SPP OUT
       "$PY" "$HERE/mitsuba_render_rough.py" "$PEERS" "$OBJ" ${spheres[@]+"${spheres[@]}"} \
         ${lights[@]+"${lights[@]}"} ${glossy[@]+"${glossy[@]}"} --tf "$TF" --camera "$TMP/camera.json" \
-        --width "$W" --height "$H" --spp "$1" --spp-per-pass 16 --seed 7 --integrator "$integrator" \
+        --width "$W" --height "$H" --spp "$1" --spp-per-pass 16 --seed "${PEER_SEED:-7}" --integrator "$integrator" \
         --max-depth -1 --rr-depth 5 --sampler independent --rfilter box --variant llvm_ad_rgb \
         -o "$2" > /dev/null
     }
+    if [ -n "${PEER_SPP:-}" ]; then
+      mi "$PEER_SPP" "$out"
+      echo "settings: Mitsuba 3 $integrator (llvm_ad_rgb, all cores), $PEER_SPP spp (PEER_SPP), seed ${PEER_SEED:-7}, independent sampler, box filter"
+      exit 0
+    fi
     cache=${PEER_CACHE:-$(dirname "$out")/peer-cache}
     mkdir -p "$cache"
     key=$(cat "$scene" "$TMP/camera.json" | cksum | cut -d' ' -f1)

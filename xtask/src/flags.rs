@@ -79,6 +79,11 @@ cargo xtask <command>   (the photonflow commands build the `photonflow` binary w
   bench load [--sizes 100000,1000000,4000000] [--runs N] [--dir DIR]
                       load time (parse, BVH) and peak memory of generated meshes, each load a
                       fresh process; Mitsuba 3 beside it in the same run when PEERS_VENV is set
+  bench path [--scenes A.toml,B.toml] [--spp 64,256] [--runs N] [--dir DIR]
+                      the path tracer's efficiency 1/(relMSE x seconds) against Mitsuba 3's
+                      at equal spp (worksheet and McGuire's Original box by default): runs
+                      alternating, each a fresh process, the noise measured between runs
+                      (Mitsuba beside it when PEERS and PEERS_VENV are set)
   bench knn [--photons N] [--queries N]
                       k-NN queries/s for k = 50, 250, 1000 per index (kd-tree, kiddo, brute),
                       and pixel-order irradiance queries with radius hints
@@ -133,7 +138,7 @@ pub const FORWARDED: &[&str] = &[
 
 /// `bench <what>`: the binary's `bench-<what>`, its output recorded in docs/benchmarks.md.
 pub const BENCHES: &[&str] = &[
-    "rays", "photons", "store", "knn", "splat", "accuracy", "load",
+    "rays", "photons", "store", "knn", "splat", "accuracy", "load", "path",
 ];
 
 /// The commands xtask runs itself. `parse` matches each by name, so only the tests read the

@@ -1,11 +1,12 @@
 //! `lab`: the studies built on `render`, which `render` never imports. Worksheet 7's report
 //! ([`worksheet`]), the evidence ladders ([`evidence`]) and their lab report ([`report`],
-//! [`plots`]), the accuracy benchmark's driver ([`accuracy`]) and the speed benchmarks'
-//! ([`bench`]), the regions of an image drawn from the scene's geometry ([`regions`]), and the
+//! [`plots`]), the accuracy benchmark's driver ([`accuracy`]), the speed benchmarks'
+//! ([`bench`]) and the path tracer's efficiency against Mitsuba 3 ([`efficiency`]), the regions of an image drawn from the scene's geometry ([`regions`]), and the
 //! one cached path-traced reference they share ([`reference`]).
 
 pub mod accuracy;
 pub mod bench;
+pub mod efficiency;
 pub mod evidence;
 pub mod plots;
 pub mod reference;

@@ -123,6 +123,12 @@ fn run(cmd: Cmd, d: &Defines) -> Result<(), String> {
             Some(scene) => lab::bench::load_child(&scene),
             None => lab::bench::load(&sizes, runs, &dir),
         },
+        Cmd::BenchPath(cli::BenchPath {
+            scenes,
+            spp,
+            runs,
+            dir,
+        }) => lab::efficiency::path(&scenes, &spp, runs, &dir),
         Cmd::BenchAccuracy(a) => bench_accuracy(a),
         Cmd::Evidence(a) => evidence(a),
         Cmd::Worksheet(a) => worksheet(a, d),

@@ -251,6 +251,26 @@ fn cases() -> Vec<Case> {
             words: &["--threads must be at least 1"],
             check: absent("out"),
         },
+        Case {
+            name: "bench-path --runs 1",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "bench-path --scenes {d}/s.toml --spp 1 --runs 1 --dir {d}/out",
+            code: 1,
+            words: &["--runs 1", "at least 2"],
+            check: absent("out"),
+        },
+        Case {
+            name: "bench-path --spp 0",
+            files: good(),
+            setup: vec![],
+            prepare: None,
+            args: "bench-path --scenes {d}/s.toml --spp 0 --runs 2 --dir {d}/out",
+            code: 1,
+            words: &["--spp 0", "1..=1048576"],
+            check: absent("out"),
+        },
         // Hangs.
         Case {
             name: "sppm --photons per pass beyond what one pass can map",

@@ -165,3 +165,32 @@ pub(crate) struct BenchLoad {
     #[arg(long, hide = true)]
     pub(crate) child: Option<PathBuf>,
 }
+
+/// The path tracer's efficiency against Mitsuba 3's at equal samples per pixel.
+///
+/// Per scene and sample count, --runs runs of `render --method path --spp N` (seeds 1, 2,
+/// ...) and, with PEERS and PEERS_VENV set, of Mitsuba 3's path tracer
+/// (`tests/references/peer.sh mitsuba` at those spp), alternating, each a fresh process timed
+/// from start to finish. Both are unbiased, so a run's error is its noise: the per-pixel
+/// variance over the runs relative to the squared mean of all runs (+ 0.01). Prints wall
+/// seconds (median), that relMSE, the efficiency 1 / (relMSE x seconds), its ratio to
+/// Mitsuba's and the ratio of the image means. Images go to --dir.
+#[derive(clap::Args)]
+pub(crate) struct BenchPath {
+    /// Scene files, comma-separated.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "scenes/cornell-spheres/analytic.toml,scenes/mcguire/original.toml"
+    )]
+    pub(crate) scenes: Vec<PathBuf>,
+    /// Samples per pixel, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "64,256")]
+    pub(crate) spp: Vec<u32>,
+    /// Runs per renderer, scene and spp (at least 2: the noise is measured between them).
+    #[arg(long, default_value_t = 2)]
+    pub(crate) runs: usize,
+    /// Where the runs' images go.
+    #[arg(long, default_value = "out/bench/path")]
+    pub(crate) dir: PathBuf,
+}

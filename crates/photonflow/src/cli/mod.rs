@@ -8,7 +8,7 @@ mod studies;
 mod tools;
 
 pub(crate) use bench::{
-    BenchAccuracy, BenchKnn, BenchLoad, BenchPhotons, BenchRays, BenchSplat, BenchStore,
+    BenchAccuracy, BenchKnn, BenchLoad, BenchPath, BenchPhotons, BenchRays, BenchSplat, BenchStore,
 };
 pub(crate) use rendering::{Estimate, ImageArgs, Merge, PhotonArgs, Render, Trace};
 pub(crate) use studies::{Evidence, Worksheet};
@@ -48,6 +48,7 @@ pub(crate) enum Cmd {
     BenchAccuracy(BenchAccuracy),
     BenchKnn(BenchKnn),
     BenchLoad(BenchLoad),
+    BenchPath(BenchPath),
     Render(Render),
     Estimate(Estimate),
     Worksheet(Worksheet),
