@@ -16,7 +16,10 @@
 mod accel;
 mod bounds;
 mod bvh4;
+#[cfg(target_arch = "x86_64")]
+mod bvh8;
 pub mod float;
+mod isa;
 mod mesh;
 mod ploc;
 mod ray;
@@ -25,6 +28,7 @@ mod sphere;
 
 pub use accel::{BvhKind, Geometry, Hit, Prim};
 pub use bounds::Bounds3;
+pub use isa::Isa;
 pub use mesh::{TriMesh, smooth_vertex_normals};
 pub use ray::{Ray, SurfacePoint};
 pub use sphere::Sphere;
