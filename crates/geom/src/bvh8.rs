@@ -240,27 +240,30 @@ pub(crate) mod avx2 {
     }
 
     /// Mask of the children whose box the segment `[0, t_max]` enters, and their entry
-    /// distances; Ize 2013's `1 + 2 gamma(3)` makes the far distance conservative.
-    #[target_feature(enable = "avx2")]
-    #[inline]
-    fn node(r: &RayData, n: &Node8, t_max: f32) -> (u32, __m256) {
-        let slab = |i: usize, a: usize| _mm256_mul_ps(_mm256_sub_ps(n.b[i], r.o[a]), r.inv[a]);
-        let tn = max_into(
-            slab(r.near[2], 2),
-            max_into(
-                slab(r.near[1], 1),
-                max_into(slab(r.near[0], 0), _mm256_setzero_ps()),
-            ),
-        );
-        let tf = min_into(
-            slab(r.far[2], 2),
-            min_into(
-                slab(r.far[1], 1),
-                min_into(slab(r.far[0], 0), _mm256_set1_ps(t_max)),
-            ),
-        );
-        let robust = _mm256_set1_ps(1.0 + 2.0 * gamma(3));
-        (le(tn, _mm256_mul_ps(tf, robust)), tn)
+    /// distances; Ize 2013's `1 + 2 gamma(3)` makes the far distance conservative. A macro:
+    /// LLVM left a function call here, and `#[inline(always)]` cannot go with
+    /// `#[target_feature]` on stable Rust.
+    macro_rules! node {
+        ($r:expr, $n:expr, $t_max:expr) => {{
+            let (r, n): (&RayData, &Node8) = ($r, $n);
+            let slab = |i: usize, a: usize| _mm256_mul_ps(_mm256_sub_ps(n.b[i], r.o[a]), r.inv[a]);
+            let tn = max_into(
+                slab(r.near[2], 2),
+                max_into(
+                    slab(r.near[1], 1),
+                    max_into(slab(r.near[0], 0), _mm256_setzero_ps()),
+                ),
+            );
+            let tf = min_into(
+                slab(r.far[2], 2),
+                min_into(
+                    slab(r.far[1], 1),
+                    min_into(slab(r.far[0], 0), _mm256_set1_ps($t_max)),
+                ),
+            );
+            let robust = _mm256_set1_ps(1.0 + 2.0 * gamma(3));
+            (le(tn, _mm256_mul_ps(tf, robust)), tn)
+        }};
     }
 
     /// The BVH4's `tri4` on eight lanes: Woop, Benthin and Wald (JCGT 2013) in pbrt-v4's form
@@ -426,7 +429,7 @@ pub(crate) mod avx2 {
         loop {
             if cur & LEAF == 0 {
                 let n = &b.nodes[cur as usize];
-                let (mask, tn) = node(&r, n, best);
+                let (mask, tn) = node!(&r, n, best);
                 if mask != 0 {
                     if mask & (mask - 1) == 0 {
                         cur = n.child[mask.trailing_zeros() as usize];
@@ -491,7 +494,7 @@ pub(crate) mod avx2 {
         loop {
             if cur & LEAF == 0 {
                 let n = &b.nodes[cur as usize];
-                let (mut mask, _) = node(&r, n, ray.t_max);
+                let (mut mask, _) = node!(&r, n, ray.t_max);
                 if mask != 0 {
                     cur = n.child[mask.trailing_zeros() as usize];
                     mask &= mask - 1;
