@@ -21,7 +21,9 @@ use rayon::prelude::*;
 
 const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 
-/// Largest triangle leaf: one block of eight (tessellated Cornell scene, `bench-rays`).
+/// Largest triangle leaf: one block of eight. Two blocks (16), and block costs of 0.5 or 2,
+/// measured within noise of this on three scenes in `bench-rays`; leaves of 4 were slower on
+/// incoherent rays (docs/benchmarks.md, "vector path (AVX2) against the baseline").
 pub(crate) const LEAF_MAX: u32 = 8;
 
 /// Collapse costs per unit of area, as the BVH4's: an 8-wide node test, an 8-triangle block.
@@ -142,7 +144,10 @@ impl Bvh8 {
 /// Traversal stack entry: child reference and the distance at which the ray enters it.
 pub(crate) type Entry = (u32, f32);
 
-const INLINE_STACK: usize = 96;
+/// Per-thread stack entries: enough for trees 36 nodes deep (`stack_need` is 7 per level);
+/// deeper ones (degenerate input) use a heap stack. Never zeroed per ray, so its size costs
+/// nothing.
+const INLINE_STACK: usize = 256;
 
 thread_local! {
     static STACK: std::cell::RefCell<[Entry; INLINE_STACK]> =

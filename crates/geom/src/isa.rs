@@ -1,13 +1,14 @@
-//! Which instruction set ray casting uses, chosen once per process at run time: one binary
-//! runs everywhere. `Baseline` is the 4-wide BVH (`crates/geom/src/bvh4.rs`, SSE2, part of
-//! x86_64 itself); `Avx2` the 8-wide one (`crates/geom/src/bvh8.rs`). `PHOTONFLOW_ISA=baseline`
-//! forces the first on any processor (tests and benchmarks run both paths on one machine).
+//! Which instruction set ray casting uses, chosen at run time: one binary runs everywhere.
+//! `Baseline` is the 4-wide BVH (`crates/geom/src/bvh4.rs`, SSE2, part of x86_64 itself);
+//! `Avx2` the 8-wide one (`crates/geom/src/bvh8.rs`). The process's choice is the best the
+//! processor runs unless the program sets another ([`Isa::set_active`]; the `photonflow`
+//! binary reads `PHOTONFLOW_ISA`), so tests and benchmarks run both paths on one machine.
 //!
 //! The only module allowed `unsafe`: calling a `#[target_feature(enable = "avx2")]` function
 //! from code compiled without AVX2.
 #![allow(unsafe_code)]
 
-use std::sync::OnceLock;
+use std::sync::atomic::{AtomicU8, Ordering};
 
 /// An instruction set the ray-casting code has a path for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -18,27 +19,24 @@ pub enum Isa {
     Avx2,
 }
 
+/// The process's choice: 0 for none (the best), else `1 + Isa as u8`.
+static ACTIVE: AtomicU8 = AtomicU8::new(0);
+
 impl Isa {
-    /// The best path this processor runs, unless `PHOTONFLOW_ISA` asks for another
-    /// (`baseline`, `avx2`, or `auto`, the default); read once per process. A path the
-    /// processor lacks, or an unknown name, falls back to the best it has, with a warning.
+    /// The path geometry built from now on uses ([`crate::Geometry::new`]): the one set by
+    /// [`Isa::set_active`], else [`Isa::best`].
     pub fn active() -> Isa {
-        static ACTIVE: OnceLock<Isa> = OnceLock::new();
-        *ACTIVE.get_or_init(|| {
-            let best = Isa::best();
-            match std::env::var("PHOTONFLOW_ISA").as_deref() {
-                Err(_) | Ok("auto") | Ok("") => best,
-                Ok("baseline") => Isa::Baseline,
-                Ok("avx2") if best == Isa::Avx2 => Isa::Avx2,
-                Ok(other) => {
-                    eprintln!(
-                        "warning: PHOTONFLOW_ISA={other}: not one of auto, baseline, avx2 \
-                         that this processor runs; using {best:?}"
-                    );
-                    best
-                }
-            }
-        })
+        match ACTIVE.load(Ordering::Relaxed) {
+            1 => Isa::Baseline,
+            2 => Isa::Avx2,
+            _ => Isa::best(),
+        }
+    }
+
+    /// Makes `isa` the path of geometry built from now on; geometry already built keeps its
+    /// own.
+    pub fn set_active(isa: Isa) {
+        ACTIVE.store(1 + isa as u8, Ordering::Relaxed);
     }
 
     /// The widest path this processor runs.
@@ -47,6 +45,18 @@ impl Isa {
             Isa::Avx2
         } else {
             Isa::Baseline
+        }
+    }
+
+    /// `auto` (the best), `baseline` or `avx2`; an error for other names and for a path the
+    /// processor lacks.
+    pub fn from_name(name: &str) -> Result<Isa, String> {
+        match name {
+            "auto" => Ok(Isa::best()),
+            "baseline" => Ok(Isa::Baseline),
+            "avx2" if Isa::best() == Isa::Avx2 => Ok(Isa::Avx2),
+            "avx2" => Err("this processor has no AVX2".into()),
+            _ => Err("expected auto, baseline or avx2".into()),
         }
     }
 }

@@ -292,6 +292,19 @@ fn the_avx2_path_is_built_where_the_processor_has_it() {
     };
     assert_eq!(geo.kind(), want);
     assert_eq!(BvhKind::for_isa(Isa::Baseline), BvhKind::Bvh4);
+    // The names `PHOTONFLOW_ISA` takes.
+    assert_eq!(Isa::from_name("auto"), Ok(Isa::best()));
+    assert_eq!(Isa::from_name("baseline"), Ok(Isa::Baseline));
+    assert_eq!(Isa::from_name("avx2").is_ok(), Isa::best() == Isa::Avx2);
+    assert!(Isa::from_name("sse9").is_err());
+    // Forcing the baseline makes `Geometry::new` build the BVH4 (other tests may build
+    // geometry meanwhile: both paths are correct, so they pass either way).
+    Isa::set_active(Isa::Baseline);
+    let forced = Geometry::new(geo.mesh().clone(), geo.spheres().to_vec());
+    Isa::set_active(Isa::best());
+    assert_eq!(forced.kind(), BvhKind::Bvh4);
+    let auto = Geometry::new(geo.mesh().clone(), geo.spheres().to_vec());
+    assert_eq!(auto.kind(), want);
 }
 
 #[test]
