@@ -23,6 +23,9 @@
 //!   (`ρ/π E cos θ` on a plane in the path tracer and the photon methods, a sun disc's
 //!   irradiance and radiance, a diffuse sphere under a constant environment, colour or image,
 //!   at `ρ L` with the background at `L`).
+//! - `isa`: the vector path (AVX2, 8-wide BVH) against the baseline (4-wide BVH) on one
+//!   machine: the path tracer's means region by region within the baseline's standard
+//!   errors, and nearly every pixel bit-identical.
 //! - `point_lights`: point and spot lights against closed forms (`ρ/π I cos θ / r²` over a
 //!   plane in the path tracer and SPPM, a spot's beam, ramp and cutoff), and a point light in
 //!   the glass sphere whose light only photons find.
@@ -68,6 +71,7 @@ mod fuzz;
 mod glass;
 mod hard_cases;
 mod infinite_lights;
+mod isa;
 mod kit;
 mod light_tracing;
 mod photon_maps;

@@ -1,5 +1,8 @@
 use crate::bvh4::Bvh4;
+#[cfg(target_arch = "x86_64")]
+use crate::bvh8::Bvh8;
 use crate::float::gamma;
+use crate::isa::{Avx2, Isa};
 use crate::{Bounds3, Ray, Sphere, SurfacePoint, TriMesh};
 use glam::{Vec3, Vec3A};
 use obvhs::{
@@ -17,11 +20,26 @@ pub enum BvhKind {
     /// obvhs' 8-wide compressed BVH (Ylitie et al. 2017) over the triangles, spheres tested
     /// beside it: the previous default, kept for `bench-rays --compare`.
     CwBvh,
+    /// Our 8-wide BVH traversed with AVX2 (module `bvh8`), where the processor has AVX2;
+    /// elsewhere a `Bvh4` is built instead.
+    Bvh8,
+}
+
+impl BvhKind {
+    /// The structure ray casting uses on instruction set `isa`.
+    pub fn for_isa(isa: Isa) -> BvhKind {
+        match isa {
+            Isa::Baseline => BvhKind::Bvh4,
+            Isa::Avx2 => BvhKind::Bvh8,
+        }
+    }
 }
 
 enum Accel {
     None,
     Bvh4(Bvh4),
+    #[cfg(target_arch = "x86_64")]
+    Bvh8(Bvh8),
     CwBvh(CwBvh),
 }
 
@@ -64,13 +82,28 @@ pub struct Geometry {
 }
 
 impl Geometry {
+    /// The structure of the process's instruction set ([`Isa::active`]).
     pub fn new(mesh: TriMesh, spheres: Vec<Sphere>) -> Geometry {
-        Geometry::with_bvh(mesh, spheres, BvhKind::default())
+        Geometry::with_bvh(mesh, spheres, BvhKind::for_isa(Isa::active()))
     }
 
     pub fn with_bvh(mesh: TriMesh, spheres: Vec<Sphere>, kind: BvhKind) -> Geometry {
         let start = std::time::Instant::now();
+        let kind = match (kind, Avx2::detect()) {
+            (BvhKind::Bvh8, None) => BvhKind::Bvh4,
+            (k, _) => k,
+        };
         let (accel, order, rt) = match kind {
+            #[cfg(target_arch = "x86_64")]
+            BvhKind::Bvh8 => {
+                let isa = Avx2::detect().expect("checked above");
+                match Bvh8::build(&mesh, &spheres, BvhBuildParams::medium_build(), isa) {
+                    Some(b) => (Accel::Bvh8(b), Vec::new(), Vec::new()),
+                    None => (Accel::None, Vec::new(), Vec::new()),
+                }
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            BvhKind::Bvh8 => unreachable!("no AVX2 outside x86_64"),
             BvhKind::Bvh4 => {
                 // `slow_build` and `very_slow_build` (more PLOC search, more reinsertion; their
                 // spatial pre-splits do not apply to a build from boxes) traversed within noise
@@ -121,6 +154,16 @@ impl Geometry {
         }
     }
 
+    /// The structure that was built (`Bvh8` asked for without AVX2 builds a `Bvh4`).
+    pub fn kind(&self) -> BvhKind {
+        match self.accel {
+            #[cfg(target_arch = "x86_64")]
+            Accel::Bvh8(_) => BvhKind::Bvh8,
+            Accel::CwBvh(_) => BvhKind::CwBvh,
+            _ => BvhKind::Bvh4,
+        }
+    }
+
     /// Seconds the ray-casting index took to build.
     pub fn build_seconds(&self) -> f64 {
         self.build_seconds
@@ -150,6 +193,8 @@ impl Geometry {
     pub fn closest(&self, ray: &Ray) -> Option<(f32, Prim)> {
         match &self.accel {
             Accel::Bvh4(b) => b.intersect(ray, &self.spheres),
+            #[cfg(target_arch = "x86_64")]
+            Accel::Bvh8(b) => b.intersect(ray, &self.spheres),
             _ => self.intersect_cwbvh(ray),
         }
     }
@@ -197,8 +242,11 @@ impl Geometry {
 
     /// True if anything is hit with `0 < t < ray.t_max` (shadow rays).
     pub fn occluded(&self, ray: &Ray) -> bool {
-        if let Accel::Bvh4(b) = &self.accel {
-            return b.occluded(ray, &self.spheres);
+        match &self.accel {
+            Accel::Bvh4(b) => return b.occluded(ray, &self.spheres),
+            #[cfg(target_arch = "x86_64")]
+            Accel::Bvh8(b) => return b.occluded(ray, &self.spheres),
+            _ => {}
         }
         if self.spheres.iter().any(|s| s.intersect(ray).is_some()) {
             return true;
@@ -216,6 +264,8 @@ impl Geometry {
     pub fn intersect_brute_force(&self, ray: &Ray) -> Option<Hit> {
         let (t, prim) = match &self.accel {
             Accel::Bvh4(b) => b.brute_force(ray, &self.spheres)?,
+            #[cfg(target_arch = "x86_64")]
+            Accel::Bvh8(b) => b.brute_force(ray, &self.spheres)?,
             _ => self.brute_force_cwbvh(ray)?,
         };
         Some(self.hit(ray, prim, t))

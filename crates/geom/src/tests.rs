@@ -1,7 +1,9 @@
 //! Tests of `geom` against independent references: f64 Cramer's-rule triangles, f64
 //! geometric spheres, and brute force over all primitives.
 
-use crate::{BvhKind, Geometry, Prim, Ray, Sphere, SurfacePoint, TriMesh, smooth_vertex_normals};
+use crate::{
+    BvhKind, Geometry, Isa, Prim, Ray, Sphere, SurfacePoint, TriMesh, smooth_vertex_normals,
+};
 use glam::{DVec3, Vec2, Vec3};
 use math::Rng;
 
@@ -241,7 +243,7 @@ fn test_scene(kind: BvhKind) -> Geometry {
 
 #[test]
 fn bvh_closest_hits_equal_brute_force() {
-    for kind in [BvhKind::Bvh4, BvhKind::CwBvh] {
+    for kind in [BvhKind::Bvh4, BvhKind::Bvh8, BvhKind::CwBvh] {
         let geo = test_scene(kind);
         let mut rng = Rng::new(99);
         let mut hits = 0;
@@ -278,6 +280,60 @@ fn bvh_closest_hits_equal_brute_force() {
         }
         assert!(hits > 1_000, "{kind:?}: {hits} hits");
     }
+}
+
+#[test]
+fn the_avx2_path_is_built_where_the_processor_has_it() {
+    let geo = test_scene(BvhKind::Bvh8);
+    let want = if Isa::best() == Isa::Avx2 {
+        BvhKind::Bvh8
+    } else {
+        BvhKind::Bvh4
+    };
+    assert_eq!(geo.kind(), want);
+    assert_eq!(BvhKind::for_isa(Isa::Baseline), BvhKind::Bvh4);
+    // The names `PHOTONFLOW_ISA` takes.
+    assert_eq!(Isa::from_name("auto"), Ok(Isa::best()));
+    assert_eq!(Isa::from_name("baseline"), Ok(Isa::Baseline));
+    assert_eq!(Isa::from_name("avx2").is_ok(), Isa::best() == Isa::Avx2);
+    assert!(Isa::from_name("sse9").is_err());
+    // Forcing the baseline makes `Geometry::new` build the BVH4 (other tests may build
+    // geometry meanwhile: both paths are correct, so they pass either way).
+    Isa::set_active(Isa::Baseline);
+    let forced = Geometry::new(geo.mesh().clone(), geo.spheres().to_vec());
+    Isa::set_active(Isa::best());
+    assert_eq!(forced.kind(), BvhKind::Bvh4);
+    let auto = Geometry::new(geo.mesh().clone(), geo.spheres().to_vec());
+    assert_eq!(auto.kind(), want);
+}
+
+#[test]
+fn bvh8_and_bvh4_find_the_same_hits_to_the_bit() {
+    // Each AVX2 lane computes what the SSE lane computes: the same t, bit for bit, and the
+    // same primitive but for ties on shared edges (the visiting order differs).
+    let (b4, b8) = (test_scene(BvhKind::Bvh4), test_scene(BvhKind::Bvh8));
+    let mut rng = Rng::new(7);
+    let (mut hits, mut same_prim) = (0, 0);
+    for _ in 0..20_000 {
+        let ray = Ray::new(rand_vec(&mut rng, -6.0, 6.0), rand_dir(&mut rng));
+        let (a, b) = (b4.closest(&ray), b8.closest(&ray));
+        assert_eq!(
+            a.map(|h| h.0.to_bits()),
+            b.map(|h| h.0.to_bits()),
+            "{ray:?}"
+        );
+        if let (Some(a), Some(b)) = (a, b) {
+            hits += 1;
+            same_prim += (a.1 == b.1) as usize;
+        }
+        let seg = Ray { t_max: 2.0, ..ray };
+        assert_eq!(b4.occluded(&seg), b8.occluded(&seg), "{seg:?}");
+    }
+    assert!(hits > 5_000, "{hits} hits");
+    assert!(
+        same_prim as f64 > 0.999 * hits as f64,
+        "{same_prim} of {hits}"
+    );
 }
 
 #[test]
@@ -461,7 +517,7 @@ fn shading_normals_interpolate_and_face_the_same_side() {
 #[test]
 fn hits_closer_than_the_bvh_node_epsilon_are_found() {
     // obvhs' CwBvh skips nodes closer than t = 1e-4; `Geometry` must not (see T_SHIFT).
-    for kind in [BvhKind::Bvh4, BvhKind::CwBvh] {
+    for kind in [BvhKind::Bvh4, BvhKind::Bvh8, BvhKind::CwBvh] {
         let floor = quad(
             Vec3::new(-1.0, 0.0, -1.0),
             Vec3::new(-1.0, 0.0, 1.0),
@@ -495,7 +551,7 @@ fn hits_closer_than_the_bvh_node_epsilon_are_found() {
 fn directions_with_negative_zero_components_hit() {
     // Regression: -Vec3::Y is (-0, -1, -0); obvhs chose the octant and the inverse direction
     // with different signs for -0.0 and the CwBvh missed the floor.
-    for kind in [BvhKind::Bvh4, BvhKind::CwBvh] {
+    for kind in [BvhKind::Bvh4, BvhKind::Bvh8, BvhKind::CwBvh] {
         let floor = quad(
             Vec3::new(-1.0, 0.0, -1.0),
             Vec3::new(-1.0, 0.0, 1.0),

@@ -2,7 +2,7 @@
 //! starts; each kind is timed `runs` times and the median reported (machines are shared and
 //! noisy, so one run says little).
 
-use geom::{BvhKind, Geometry, Ray};
+use geom::{BvhKind, Geometry, Isa, Ray};
 use glam::Vec3;
 use math::Rng;
 use std::path::Path;
@@ -67,32 +67,51 @@ pub fn rays(
         // are timed on the same core (the Embree script pins itself to the first it may use).
         println!("CPUs this process may run on: {cpus}");
     }
+    // The baseline BVH4 and, where the processor has AVX2, the BVH8 (`PHOTONFLOW_ISA` does
+    // not apply here: both are timed), in alternating rounds so that both see the same load.
     let mut kinds = vec![BvhKind::Bvh4];
+    if Isa::best() == Isa::Avx2 {
+        kinds.push(BvhKind::Bvh8);
+    }
     if compare {
         kinds.push(BvhKind::CwBvh);
     }
-    let mut ours_first: Vec<f64> = Vec::new();
-    for (k, kind) in kinds.into_iter().enumerate() {
-        let t0 = Instant::now();
-        let geo = Geometry::with_bvh(
-            s.geometry.mesh().clone(),
-            s.geometry.spheres().to_vec(),
-            kind,
-        );
-        let build = t0.elapsed();
-        for (name, rays, reference) in &sets {
-            let (mrays, hits) = median_rate(&geo, rays, runs);
-            if k == 0 {
-                ours_first.push(mrays);
+    let geos: Vec<(Geometry, f64)> = kinds
+        .iter()
+        .map(|&kind| {
+            let t0 = Instant::now();
+            let geo = Geometry::with_bvh(
+                s.geometry.mesh().clone(),
+                s.geometry.spheres().to_vec(),
+                kind,
+            );
+            (geo, t0.elapsed().as_secs_f64())
+        })
+        .collect();
+    for (name, rays, reference) in &sets {
+        let mut rates = vec![Vec::new(); geos.len()];
+        let mut records = vec![Vec::new(); geos.len()];
+        let mut hits = 0;
+        for _ in 0..runs {
+            for (k, (geo, _)) in geos.iter().enumerate() {
+                let (rate, h) = median_rate(geo, rays, 1);
+                hits = h;
+                rates[k].push(rate);
+                records[k].push(median_rate_with_record(geo, rays, 1));
             }
-            let record = median_rate_with_record(&geo, rays, runs);
+        }
+        let medians: Vec<f64> = rates.iter_mut().map(|r| median(r)).collect();
+        for (k, (geo, build)) in geos.iter().enumerate() {
+            let record = median(&mut records[k]);
             println!(
-                "{name:>10}: {mrays:7.2} M rays/s  ({kind:?}, build {:.1} ms, {:.1}% hit; {record:.2} M/s with the surface record)",
-                build.as_secs_f64() * 1e3,
+                "{name:>10}: {:7.2} M rays/s  ({:?}, build {:.1} ms, {:.1}% hit; {record:.2} M/s with the surface record)",
+                medians[k],
+                geo.kind(),
+                build * 1e3,
                 100.0 * hits as f64 / rays.len() as f64
             );
             if let Some(t_ref) = reference {
-                let a = agreement(&geo, rays, t_ref);
+                let a = agreement(geo, rays, t_ref);
                 println!(
                     "{:>10}  vs reference hits: hit/miss agree on {:.4}% of rays; closest-hit distance within 1e-4 relative on {:.4}% of rays ({:.4}% of rays both hit)",
                     "",
@@ -102,6 +121,13 @@ pub fn rays(
                 );
             }
         }
+        if kinds.get(1) == Some(&BvhKind::Bvh8) {
+            println!(
+                "{:>10}  Bvh8 (AVX2) / Bvh4 (baseline): {:.2}x",
+                "",
+                medians[1] / medians[0]
+            );
+        }
     }
     if let Some((name, command)) = peer {
         peer_ratios(&s.geometry, &sets, runs, name, command)?;
@@ -109,7 +135,7 @@ pub fn rays(
     Ok(())
 }
 
-/// The peer and our default BVH in alternating rounds (peer, then ours, `runs` times), so
+/// The peer and our default BVH (this process's instruction set) in alternating rounds (peer, then ours, `runs` times), so
 /// both see the same machine load; medians of each and their ratio. The peer is a shell
 /// command printing lines with `coherent` or `incoherent` and a rate `X Mrays/s` (or
 /// `M rays/s`), one thread (e.g. Embree 4 through its Python bindings, pinned to one CPU).
@@ -123,7 +149,7 @@ fn peer_ratios(
     let geo = Geometry::with_bvh(
         geometry.mesh().clone(),
         geometry.spheres().to_vec(),
-        BvhKind::Bvh4,
+        BvhKind::for_isa(Isa::active()),
     );
     let mut theirs: Vec<Vec<f64>> = vec![Vec::new(); sets.len()];
     let mut ours: Vec<Vec<f64>> = vec![Vec::new(); sets.len()];

@@ -25,6 +25,17 @@ fn main() -> ExitCode {
         }
         default_hook(info);
     }));
+    // The instruction set of ray casting, for the process (README, ARCHITECTURE.md).
+    if let Some(name) = std::env::var_os("PHOTONFLOW_ISA") {
+        let name = name.to_string_lossy();
+        match geom::Isa::from_name(&name) {
+            Ok(isa) => geom::Isa::set_active(isa),
+            Err(e) => eprintln!(
+                "warning: PHOTONFLOW_ISA={name}: {e}; using {:?}",
+                geom::Isa::best()
+            ),
+        }
+    }
     let (code, error) = photonflow::run_args(std::env::args_os());
     if let Some(e) = error {
         eprintln!("{e}");
