@@ -15,7 +15,7 @@ use crate::float::{gamma, next_down, next_up};
 use crate::ploc::{self, Work};
 use crate::simd::{F4, Lanes};
 use crate::{Prim, Ray, Sphere, TriMesh};
-use obvhs::bvh2::{Bvh2, leaf_collapser::collapse, reinsertion::ReinsertionOptimizer};
+use obvhs::bvh2::Bvh2;
 use obvhs::ploc::PlocSearchDistance;
 use obvhs::{BvhBuildParams, aabb::Aabb};
 use rayon::prelude::*;
@@ -503,8 +503,9 @@ enum Choice {
 ///
 /// The steps of obvhs' `build_bvh2` (obvhs 0.4, its `bvh2` builder: PLOC, reinsertion,
 /// collapse, reinsertion) with PLOC's leaves written straight from the mesh, not from a list
-/// of boxes the builder copies, and PLOC itself run over lean buffers (`ploc.rs`): the same
-/// `Bvh2`, which `tests/bvh4.rs` checks against `build_bvh2`.
+/// of boxes the builder copies, PLOC itself run over lean buffers and both PLOC and the
+/// reinsertions' searches on every core (`crates/geom/src/ploc.rs`): the same `Bvh2` for any
+/// thread count, which `crates/geom/src/tests/bvh4.rs` checks against `build_bvh2`.
 pub(crate) fn binary_bvh(
     mesh: &TriMesh,
     spheres: &[Sphere],
@@ -535,14 +536,12 @@ pub(crate) fn binary_bvh(
         PlocSearchDistance::High => ploc::build::<24>(b, leaves, total, precision, depth),
         PlocSearchDistance::VeryHigh => ploc::build::<32>(b, leaves, total, precision, depth),
     }
-    let mut reinsertion = ReinsertionOptimizer::default();
-    reinsertion.run(&mut bvh, params.reinsertion_batch_ratio, None);
-    // One primitive per leaf: the collapse forms the leaves.
-    collapse(&mut bvh, 1, params.collapse_traversal_cost);
-    reinsertion.run(
+    ploc::reinsert(&mut bvh, params.reinsertion_batch_ratio);
+    // One primitive per leaf: the collapse forms the leaves, and obvhs' leaf collapse between
+    // the two reinsertions leaves such a tree as it is.
+    ploc::reinsert(
         &mut bvh,
         params.reinsertion_batch_ratio * params.post_collapse_reinsertion_batch_ratio_multiplier,
-        None,
     );
     Some(bvh)
 }
