@@ -242,3 +242,29 @@ fn the_lean_binary_build_is_obvhs_build() {
         }
     }
 }
+
+/// The collapse and the emission run subtrees on several threads: the 4-wide BVH (nodes,
+/// their order, blocks) must be the same on one thread and on several, on a tree deeper than
+/// the depths where tasks split.
+#[test]
+fn the_bvh4_is_the_same_on_any_thread_count() {
+    let (mesh, spheres) = scene(60_000, 5, 3);
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| Bvh4::build(&mesh, &spheres, BvhBuildParams::medium_build()).unwrap())
+    };
+    let one = on(1);
+    let (root, stack_need, blocks) = one.built();
+    assert!(stack_need > 3 * 8, "depth {}", stack_need / 3);
+    for threads in [2, 3] {
+        let b = on(threads);
+        assert_eq!(b.nodes.len(), one.nodes.len());
+        for (x, y) in b.nodes.iter().zip(&one.nodes) {
+            assert_eq!((x.b, x.child), (y.b, y.child));
+        }
+        assert_eq!(b.built(), (root, stack_need, blocks.clone()));
+    }
+}
