@@ -512,15 +512,15 @@ pub(crate) fn binary_bvh(
     }
     let mut bvh = Bvh2::zeroed(n);
     bvh.reset_for_reuse(n, Some((0..n as u32).collect()));
-    let mut total = Aabb::empty();
-    let leaves: Vec<Work> = prim_boxes(mesh, spheres)
-        .enumerate()
-        .map(|(i, b)| {
-            total.extend(b.min);
-            total.extend(b.max);
-            Work::leaf(b, i as u32)
-        })
+    let leaves: Vec<Work> = (0..n)
+        .into_par_iter()
+        .map(|i| Work::leaf(prim_box(mesh, spheres, i), i as u32))
         .collect();
+    // Minima and maxima, exact in any order.
+    let total = leaves
+        .par_iter()
+        .map(Work::aabb)
+        .reduce(Aabb::empty, |a, b| a.union(&b));
     let (precision, depth) = (params.sort_precision, params.search_depth_threshold);
     let b = &mut bvh;
     match params.ploc_search_distance {
@@ -541,21 +541,31 @@ pub(crate) fn binary_bvh(
     Some(bvh)
 }
 
-/// Each primitive's box: triangles, then spheres (the f32 box of a sphere widened by an ulp
-/// so it contains the exact sphere).
+/// Each primitive's box: triangles, then spheres (the boxes obvhs' own build is given in the
+/// tests).
+#[cfg(test)]
 pub(crate) fn prim_boxes<'a>(
     mesh: &'a TriMesh,
     spheres: &'a [Sphere],
 ) -> impl Iterator<Item = Aabb> + 'a {
-    let tris = (0..mesh.len()).map(|i| {
-        let [a, b, c] = mesh.vertices(i);
-        Aabb::new(a.min(b).min(c).into(), a.max(b).max(c).into())
-    });
-    tris.chain(spheres.iter().map(|s| {
-        let lo = (s.center - s.radius).to_array().map(next_down);
-        let hi = (s.center + s.radius).to_array().map(next_up);
-        Aabb::new(glam::Vec3A::from_array(lo), glam::Vec3A::from_array(hi))
-    }))
+    (0..mesh.len() + spheres.len()).map(|i| prim_box(mesh, spheres, i))
+}
+
+/// Primitive `i`'s box: triangle `i`, or sphere `i - mesh.len()` (its f32 box widened by an
+/// ulp so it contains the exact sphere).
+fn prim_box(mesh: &TriMesh, spheres: &[Sphere], i: usize) -> Aabb {
+    match i.checked_sub(mesh.len()) {
+        None => {
+            let [a, b, c] = mesh.vertices(i);
+            Aabb::new(a.min(b).min(c).into(), a.max(b).max(c).into())
+        }
+        Some(s) => {
+            let s = &spheres[s];
+            let lo = (s.center - s.radius).to_array().map(next_down);
+            let hi = (s.center + s.radius).to_array().map(next_up);
+            Aabb::new(glam::Vec3A::from_array(lo), glam::Vec3A::from_array(hi))
+        }
+    }
 }
 
 /// Four choices in four bits each: the variant in two, `k` (at most 3) in the other two.

@@ -46,7 +46,7 @@ impl Work {
     }
 
     #[inline(always)]
-    fn aabb(&self) -> Aabb {
+    pub(crate) fn aabb(&self) -> Aabb {
         Aabb::new(Vec3A::from(self.min), Vec3A::from(self.max))
     }
 
@@ -90,13 +90,14 @@ impl RadixKey for Morton128 {
     }
 }
 
-/// The leaves in Morton order of their centres (obvhs' `sort_nodes_by_morton`, sequential).
+/// The leaves in Morton order of their centres (obvhs' `sort_nodes_by_morton`: its sequential
+/// sort, the codes and the gather on every core).
 fn sorted(leaves: &[Work], precision: SortPrecision, scale: DVec3, offset: DVec3) -> Vec<Work> {
     let center = |w: &Work| w.aabb().center().as_dvec3() * scale + offset;
     match precision {
         SortPrecision::U64 => {
             let mut m: Vec<Morton64> = leaves
-                .iter()
+                .par_iter()
                 .enumerate()
                 .map(|(i, w)| Morton64 {
                     code: morton_encode_u64_unorm(center(w)),
@@ -108,11 +109,11 @@ fn sorted(leaves: &[Work], precision: SortPrecision, scale: DVec3, offset: DVec3
             } else {
                 m.radix_sort_unstable();
             }
-            m.iter().map(|m| leaves[m.index as usize]).collect()
+            m.par_iter().map(|m| leaves[m.index as usize]).collect()
         }
         SortPrecision::U128 => {
             let mut m: Vec<Morton128> = leaves
-                .iter()
+                .par_iter()
                 .enumerate()
                 .map(|(i, w)| Morton128 {
                     code: morton_encode_u128_unorm(center(w)),
@@ -125,7 +126,7 @@ fn sorted(leaves: &[Work], precision: SortPrecision, scale: DVec3, offset: DVec3
             } else {
                 m.radix_sort_unstable();
             }
-            m.iter().map(|m| leaves[m.index as usize]).collect()
+            m.par_iter().map(|m| leaves[m.index as usize]).collect()
         }
     }
 }
@@ -440,14 +441,18 @@ struct Chunk([u32; 4]);
 /// `bvh`'s nodes as `Node2`, written over its own node list (a node moves to an earlier
 /// address, over nodes already read) and the list then shrunk: no second list of nodes at any
 /// time, and `bvh`'s other lists freed. Leaves must hold one primitive each.
+///
+/// Node `i` moves from chunks `3i..3i + 3` to `2i..2i + 2`: once nodes `..a` have moved,
+/// nodes `a..3a / 2` write only where nodes before `a` were read, so each such range moves on
+/// every core, into the same places as one after another.
 pub(crate) fn compact(mut bvh: Bvh2) -> Vec<Node2> {
     let nodes = std::mem::take(&mut bvh.nodes);
     let prims = std::mem::take(&mut bvh.primitive_indices);
     drop(bvh);
     let len = nodes.len();
     let mut c: Vec<Chunk> = bytemuck::allocation::cast_vec(nodes);
-    for i in 0..len {
-        let n: Bvh2Node = bytemuck::cast([c[3 * i], c[3 * i + 1], c[3 * i + 2]]);
+    let node2 = |from: &[Chunk], to: &mut [Chunk]| {
+        let n: Bvh2Node = bytemuck::cast([from[0], from[1], from[2]]);
         let b = n.aabb();
         let (first, prim) = if n.prim_count == 0 {
             (n.first_index, 0)
@@ -463,8 +468,23 @@ pub(crate) fn compact(mut bvh: Bvh2) -> Vec<Node2> {
             prim,
         };
         let [x, y]: [Chunk; 2] = bytemuck::cast(out);
-        c[2 * i] = x;
-        c[2 * i + 1] = y;
+        to[0] = x;
+        to[1] = y;
+    };
+    // The first nodes one after another (their moves overlap their own reads).
+    let mut a = len.min(1 << 10);
+    for i in 0..a {
+        let from: [Chunk; 3] = [c[3 * i], c[3 * i + 1], c[3 * i + 2]];
+        node2(&from, &mut c[2 * i..2 * i + 2]);
+    }
+    while a < len {
+        let b = (a + a / 2).min(len);
+        let (done, rest) = c.split_at_mut(3 * a);
+        done[2 * a..2 * b]
+            .par_chunks_mut(2)
+            .zip(rest[..3 * (b - a)].par_chunks(3))
+            .for_each(|(to, from)| node2(from, to));
+        a = b;
     }
     drop(prims);
     c.truncate(2 * len);
