@@ -15,11 +15,12 @@ use crate::float::{gamma, next_down, next_up};
 use crate::ploc::{self, Work};
 use crate::simd::{F4, Lanes};
 use crate::{Prim, Ray, Sphere, TriMesh};
-use obvhs::bvh2::{Bvh2, leaf_collapser::collapse, reinsertion::ReinsertionOptimizer};
+use obvhs::bvh2::Bvh2;
 use obvhs::ploc::PlocSearchDistance;
 use obvhs::{BvhBuildParams, aabb::Aabb};
 use rayon::prelude::*;
 use std::ops::{Add, Div, Mul, Sub};
+use std::sync::atomic::{AtomicU16, AtomicU64, Ordering};
 
 /// Child reference: an inner node's index, or a leaf tagged by `LEAF`.
 pub(crate) const LEAF: u32 = 1 << 31;
@@ -249,16 +250,10 @@ impl Bvh4 {
         let bvh2 = binary_bvh(mesh, spheres, params)?;
         let nodes = ploc::compact(bvh2);
         let b = Builder {
-            choice: vec![0; nodes.len()],
+            choice: (0..nodes.len()).map(|_| AtomicU16::new(0)).collect(),
+            size: (0..nodes.len()).map(|_| AtomicU64::new(0)).collect(),
             bvh2: &nodes,
             n_tri: n_tri as u32,
-            out: Bvh4 {
-                nodes: Vec::new(),
-                tris: Vec::new(),
-                ids: Vec::new(),
-                root: EMPTY,
-                stack_need: 1,
-            },
         };
         let mut out = b.collapse();
         drop(nodes);
@@ -503,8 +498,9 @@ enum Choice {
 ///
 /// The steps of obvhs' `build_bvh2` (obvhs 0.4, its `bvh2` builder: PLOC, reinsertion,
 /// collapse, reinsertion) with PLOC's leaves written straight from the mesh, not from a list
-/// of boxes the builder copies, and PLOC itself run over lean buffers (`ploc.rs`): the same
-/// `Bvh2`, which `tests/bvh4.rs` checks against `build_bvh2`.
+/// of boxes the builder copies, PLOC itself run over lean buffers and both PLOC and the
+/// reinsertions' searches on every core (`crates/geom/src/ploc.rs`): the same `Bvh2` for any
+/// thread count, which `crates/geom/src/tests/bvh4.rs` checks against `build_bvh2`.
 pub(crate) fn binary_bvh(
     mesh: &TriMesh,
     spheres: &[Sphere],
@@ -516,15 +512,15 @@ pub(crate) fn binary_bvh(
     }
     let mut bvh = Bvh2::zeroed(n);
     bvh.reset_for_reuse(n, Some((0..n as u32).collect()));
-    let mut total = Aabb::empty();
-    let leaves: Vec<Work> = prim_boxes(mesh, spheres)
-        .enumerate()
-        .map(|(i, b)| {
-            total.extend(b.min);
-            total.extend(b.max);
-            Work::leaf(b, i as u32)
-        })
+    let leaves: Vec<Work> = (0..n)
+        .into_par_iter()
+        .map(|i| Work::leaf(prim_box(mesh, spheres, i), i as u32))
         .collect();
+    // Minima and maxima, exact in any order.
+    let total = leaves
+        .par_iter()
+        .map(Work::aabb)
+        .reduce(Aabb::empty, |a, b| a.union(&b));
     let (precision, depth) = (params.sort_precision, params.search_depth_threshold);
     let b = &mut bvh;
     match params.ploc_search_distance {
@@ -535,33 +531,41 @@ pub(crate) fn binary_bvh(
         PlocSearchDistance::High => ploc::build::<24>(b, leaves, total, precision, depth),
         PlocSearchDistance::VeryHigh => ploc::build::<32>(b, leaves, total, precision, depth),
     }
-    let mut reinsertion = ReinsertionOptimizer::default();
-    reinsertion.run(&mut bvh, params.reinsertion_batch_ratio, None);
-    // One primitive per leaf: the collapse forms the leaves.
-    collapse(&mut bvh, 1, params.collapse_traversal_cost);
-    reinsertion.run(
+    ploc::reinsert(&mut bvh, params.reinsertion_batch_ratio);
+    // One primitive per leaf: the collapse forms the leaves, and obvhs' leaf collapse between
+    // the two reinsertions leaves such a tree as it is.
+    ploc::reinsert(
         &mut bvh,
         params.reinsertion_batch_ratio * params.post_collapse_reinsertion_batch_ratio_multiplier,
-        None,
     );
     Some(bvh)
 }
 
-/// Each primitive's box: triangles, then spheres (the f32 box of a sphere widened by an ulp
-/// so it contains the exact sphere).
+/// Each primitive's box: triangles, then spheres (the boxes obvhs' own build is given in the
+/// tests).
+#[cfg(test)]
 pub(crate) fn prim_boxes<'a>(
     mesh: &'a TriMesh,
     spheres: &'a [Sphere],
 ) -> impl Iterator<Item = Aabb> + 'a {
-    let tris = (0..mesh.len()).map(|i| {
-        let [a, b, c] = mesh.vertices(i);
-        Aabb::new(a.min(b).min(c).into(), a.max(b).max(c).into())
-    });
-    tris.chain(spheres.iter().map(|s| {
-        let lo = (s.center - s.radius).to_array().map(next_down);
-        let hi = (s.center + s.radius).to_array().map(next_up);
-        Aabb::new(glam::Vec3A::from_array(lo), glam::Vec3A::from_array(hi))
-    }))
+    (0..mesh.len() + spheres.len()).map(|i| prim_box(mesh, spheres, i))
+}
+
+/// Primitive `i`'s box: triangle `i`, or sphere `i - mesh.len()` (its f32 box widened by an
+/// ulp so it contains the exact sphere).
+fn prim_box(mesh: &TriMesh, spheres: &[Sphere], i: usize) -> Aabb {
+    match i.checked_sub(mesh.len()) {
+        None => {
+            let [a, b, c] = mesh.vertices(i);
+            Aabb::new(a.min(b).min(c).into(), a.max(b).max(c).into())
+        }
+        Some(s) => {
+            let s = &spheres[s];
+            let lo = (s.center - s.radius).to_array().map(next_down);
+            let hi = (s.center + s.radius).to_array().map(next_up);
+            Aabb::new(glam::Vec3A::from_array(lo), glam::Vec3A::from_array(hi))
+        }
+    }
 }
 
 /// Four choices in four bits each: the variant in two, `k` (at most 3) in the other two.
@@ -596,148 +600,284 @@ struct Builder<'a> {
     /// Per Bvh2 node and slot count `i` (index `i - 1`): the choice that reaches the least
     /// SAH cost of the subtree as a forest of at most `i` subtrees. The costs themselves
     /// travel up the recursion: a node's are read by its parent only. Packed by `pack`.
-    choice: Vec<u16>,
-    out: Bvh4,
+    /// Atomic only so that subtrees fill it on several threads (each its own entries).
+    choice: Vec<AtomicU16>,
+    /// Per Bvh2 node: the nodes and leaf blocks its one-slot choice emits, so that subtrees
+    /// are emitted on several threads each into its own part of the output.
+    size: Vec<AtomicU64>,
+}
+
+/// Depths (of the Bvh2 in `optimize`, of the 4-wide BVH in `emit`) above which subtrees go
+/// to other threads: thousands of tasks, each of them a subtree large enough to be worth one.
+const PAR_DEPTH_BVH2: usize = 12;
+const PAR_DEPTH_BVH4: usize = 6;
+
+/// Nodes and leaf blocks a subtree emits.
+#[derive(Clone, Copy, Default)]
+struct Size {
+    nodes: u32,
+    blocks: u32,
+}
+
+impl Add for Size {
+    type Output = Size;
+    fn add(self, o: Size) -> Size {
+        Size {
+            nodes: self.nodes + o.nodes,
+            blocks: self.blocks + o.blocks,
+        }
+    }
+}
+
+/// What `optimize` hands up: the subtree's primitive count, whether it holds a sphere, and
+/// per slot count its least cost and the size of the forest that reaches it.
+struct Optimum {
+    count: u32,
+    sphere: bool,
+    cost: [f64; 4],
+    size: [Size; 4],
 }
 
 impl Builder<'_> {
     /// The collapsed BVH: its nodes and its blocks' triangle ids, the blocks' vertices not yet
     /// written. The choices are freed with the builder.
-    fn collapse(mut self) -> Bvh4 {
-        self.optimize(0);
-        let (root, depth) = self.emit(0);
-        self.out.root = root;
-        self.out.stack_need = 3 * depth + 1;
-        self.out.nodes.shrink_to_fit();
-        self.out.ids.shrink_to_fit();
-        self.out
+    fn collapse(self) -> Bvh4 {
+        let size = self.optimize(0, 0).size[0];
+        let mut nodes = vec![
+            Node4 {
+                b: [
+                    [f32::INFINITY; 4],
+                    [f32::NEG_INFINITY; 4],
+                    [f32::INFINITY; 4],
+                    [f32::NEG_INFINITY; 4],
+                    [f32::INFINITY; 4],
+                    [f32::NEG_INFINITY; 4],
+                ],
+                child: [EMPTY; 4],
+            };
+            size.nodes as usize
+        ];
+        let mut ids = vec![[0; 4]; size.blocks as usize];
+        assert!(
+            size.blocks <= FIRST_MASK + 1,
+            "too many triangles for the BVH4 leaf encoding"
+        );
+        let (root, depth) = self.emit(0, &mut nodes, 0, &mut ids, 0, 0);
+        Bvh4 {
+            nodes,
+            tris: Vec::new(),
+            ids,
+            root,
+            stack_need: 3 * depth + 1,
+        }
     }
 
     fn children(&self, ni: usize) -> Option<(usize, usize)> {
         self.bvh2[ni].children()
     }
 
+    fn choice(&self, ni: usize, i: usize) -> Choice {
+        unpack(self.choice[ni].load(Ordering::Relaxed), i)
+    }
+
+    fn size(&self, ni: usize) -> Size {
+        let s = self.size[ni].load(Ordering::Relaxed);
+        Size {
+            nodes: s as u32,
+            blocks: (s >> 32) as u32,
+        }
+    }
+
     /// The optimal collapse of a binary BVH into a wide one by dynamic programming over
     /// (node, slots), Ylitie, Karras and Laine, "Efficient Incoherent Ray Traversal on GPUs
     /// Through Compressed Wide BVHs" (HPG 2017) §4.1, with our leaf rule: one sphere, or up
-    /// to `LEAF_MAX` triangles. Returns the subtree's primitive count, whether it holds a
-    /// sphere, and its least cost in 1 to 4 slots.
-    fn optimize(&mut self, ni: usize) -> (u32, bool, [f64; 4]) {
+    /// to `LEAF_MAX` triangles. `depth` is `ni`'s in the Bvh2. Subtrees are independent, so
+    /// the choices do not depend on the thread count.
+    fn optimize(&self, ni: usize, depth: usize) -> Optimum {
         let node = self.bvh2[ni];
         let area = node.aabb().half_area() as f64;
         let Some((l, r)) = self.children(ni) else {
             let p = node.prim;
             let is_sphere = p >= self.n_tri;
             let c = area * if is_sphere { COST_SPHERE } else { COST_BLOCK };
-            self.choice[ni] = pack([Choice::Leaf; 4]);
-            return (1, is_sphere, [c; 4]);
+            let size = Size {
+                nodes: 0,
+                blocks: !is_sphere as u32,
+            };
+            self.set(ni, [Choice::Leaf; 4], size);
+            return Optimum {
+                count: 1,
+                sphere: is_sphere,
+                cost: [c; 4],
+                size: [size; 4],
+            };
         };
-        let (nl, sl, cl) = self.optimize(l);
-        let (nr, sr, cr) = self.optimize(r);
-        let (count, sphere) = (nl + nr, sl || sr);
+        let (a, b) = if depth < PAR_DEPTH_BVH2 {
+            rayon::join(
+                || self.optimize(l, depth + 1),
+                || self.optimize(r, depth + 1),
+            )
+        } else {
+            (self.optimize(l, depth + 1), self.optimize(r, depth + 1))
+        };
+        let (count, sphere) = (a.count + b.count, a.sphere || b.sphere);
         // Best split of `i` slots between the two children.
         let split = |i: usize| {
             (1..i)
-                .map(|k| (cl[k - 1] + cr[i - k - 1], k as u8))
+                .map(|k| (a.cost[k - 1] + b.cost[i - k - 1], k as u8))
                 .min_by(|a, b| a.0.total_cmp(&b.0))
                 .expect("i >= 2")
         };
+        let parts = |k: u8, i: usize| a.size[k as usize - 1] + b.size[i - k as usize - 1];
         let (inner, k) = split(4);
-        let mut best = (area * COST_NODE + inner, Choice::Node(k));
+        let one = Size {
+            nodes: 1,
+            blocks: 0,
+        };
+        let mut best = (area * COST_NODE + inner, Choice::Node(k), one + parts(k, 4));
         if !sphere && count <= LEAF_MAX {
-            let leaf = area * COST_BLOCK * count.div_ceil(4) as f64;
+            let blocks = count.div_ceil(4);
+            let leaf = area * COST_BLOCK * blocks as f64;
             if leaf <= best.0 {
-                best = (leaf, Choice::Leaf);
+                best = (leaf, Choice::Leaf, Size { nodes: 0, blocks });
             }
         }
         let mut cost = [best.0; 4];
         let mut choice = [best.1; 4];
+        let mut size = [best.2; 4];
         for i in 2..=4 {
             let (c, k) = split(i);
-            (cost[i - 1], choice[i - 1]) = if c < cost[i - 2] {
-                (c, Choice::Split(k))
+            (cost[i - 1], choice[i - 1], size[i - 1]) = if c < cost[i - 2] {
+                (c, Choice::Split(k), parts(k, i))
             } else {
-                (cost[i - 2], Choice::Fewer)
+                (cost[i - 2], Choice::Fewer, size[i - 2])
             };
         }
-        self.choice[ni] = pack(choice);
-        (count, sphere, cost)
+        self.set(ni, choice, size[0]);
+        Optimum {
+            count,
+            sphere,
+            cost,
+            size,
+        }
     }
 
-    /// The roots of the forest that stands for subtree `ni` in `i` slots.
-    fn forest(&self, ni: usize, i: usize, out: &mut Vec<usize>) {
-        match unpack(self.choice[ni], i) {
-            Choice::Leaf | Choice::Node(_) => out.push(ni),
-            Choice::Fewer => self.forest(ni, i - 1, out),
+    fn set(&self, ni: usize, choice: [Choice; 4], size: Size) {
+        self.choice[ni].store(pack(choice), Ordering::Relaxed);
+        let s = size.nodes as u64 | (size.blocks as u64) << 32;
+        self.size[ni].store(s, Ordering::Relaxed);
+    }
+
+    /// The roots of the forest that stands for subtree `ni` in `i` slots, appended to
+    /// `out[..*len]`.
+    fn forest(&self, ni: usize, i: usize, out: &mut [usize; 4], len: &mut usize) {
+        match self.choice(ni, i) {
+            Choice::Leaf | Choice::Node(_) => {
+                out[*len] = ni;
+                *len += 1;
+            }
+            Choice::Fewer => self.forest(ni, i - 1, out, len),
             Choice::Split(k) => {
                 let (l, r) = self.children(ni).expect("a split node has children");
-                self.forest(l, k as usize, out);
-                self.forest(r, i - k as usize, out);
+                self.forest(l, k as usize, out, len);
+                self.forest(r, i - k as usize, out, len);
             }
         }
     }
 
-    fn prims(&self, ni: usize, out: &mut Vec<u32>) {
+    /// The primitives under `ni`, appended to `out[..*len]` (a leaf holds at most
+    /// `LEAF_MAX`).
+    fn prims(&self, ni: usize, out: &mut [u32; LEAF_MAX as usize], len: &mut usize) {
         match self.children(ni) {
-            None => out.push(self.bvh2[ni].prim),
+            None => {
+                out[*len] = self.bvh2[ni].prim;
+                *len += 1;
+            }
             Some((l, r)) => {
-                self.prims(l, out);
-                self.prims(r, out);
+                self.prims(l, out, len);
+                self.prims(r, out, len);
             }
         }
     }
 
-    /// Emits the subtree under Bvh2 node `ni` as its one-slot choice; returns its reference
-    /// and depth in nodes.
-    fn emit(&mut self, ni: usize) -> (u32, usize) {
-        let Choice::Node(k) = unpack(self.choice[ni], 1) else {
-            let mut prims = Vec::new();
-            self.prims(ni, &mut prims);
+    /// Emits the subtree under Bvh2 node `ni` as its one-slot choice into `nodes` and `ids`,
+    /// exactly its size (`size`), whose first entries are numbers `node_base` and
+    /// `block_base` of the output; returns its reference and depth in nodes. The layout is
+    /// depth first, a node before its children's subtrees in slot order, whatever the
+    /// thread count: each subtree's part follows from the sizes.
+    fn emit(
+        &self,
+        ni: usize,
+        nodes: &mut [Node4],
+        node_base: u32,
+        ids: &mut [[u32; 4]],
+        block_base: u32,
+        depth: usize,
+    ) -> (u32, usize) {
+        let Choice::Node(k) = self.choice(ni, 1) else {
+            let mut prims = [0; LEAF_MAX as usize];
+            let mut len = 0;
+            self.prims(ni, &mut prims, &mut len);
             if prims[0] >= self.n_tri {
                 return (LEAF | SPHERE | (prims[0] - self.n_tri), 0);
             }
             // The blocks' triangles only: their vertices are written once the `Bvh2` is gone.
-            let first = self.out.ids.len() as u32;
-            for group in prims.chunks(4) {
-                self.out
-                    .ids
-                    .push(std::array::from_fn(|l| group[l.min(group.len() - 1)]));
+            let group = &prims[..len];
+            for (block, group) in ids.iter_mut().zip(group.chunks(4)) {
+                *block = std::array::from_fn(|l| group[l.min(group.len() - 1)]);
             }
-            let blocks = self.out.ids.len() as u32 - first;
-            assert!(
-                first <= FIRST_MASK,
-                "too many triangles for the BVH4 leaf encoding"
-            );
-            return (LEAF | (blocks << COUNT_SHIFT) | first, 0);
+            return (LEAF | ((ids.len() as u32) << COUNT_SHIFT) | block_base, 0);
         };
         let (l, r) = self.children(ni).expect("an inner node has children");
-        let mut kids = Vec::with_capacity(4);
-        self.forest(l, k as usize, &mut kids);
-        self.forest(r, 4 - k as usize, &mut kids);
-        let idx = self.out.nodes.len();
-        self.out.nodes.push(Node4 {
-            b: [
-                [f32::INFINITY; 4],
-                [f32::NEG_INFINITY; 4],
-                [f32::INFINITY; 4],
-                [f32::NEG_INFINITY; 4],
-                [f32::INFINITY; 4],
-                [f32::NEG_INFINITY; 4],
-            ],
-            child: [EMPTY; 4],
-        });
-        let mut depth = 0;
-        for (slot, &k) in kids.iter().enumerate() {
-            let (c, d) = self.emit(k);
-            depth = depth.max(d);
-            let bb = self.bvh2[k].aabb();
-            let n = &mut self.out.nodes[idx];
-            for a in 0..3 {
-                n.b[2 * a][slot] = bb.min[a];
-                n.b[2 * a + 1][slot] = bb.max[a];
-            }
-            n.child[slot] = c;
+        let mut kids = [0; 4];
+        let mut n = 0;
+        self.forest(l, k as usize, &mut kids, &mut n);
+        self.forest(r, 4 - k as usize, &mut kids, &mut n);
+        let (node, mut rest_nodes) = nodes.split_first_mut().expect("sized by `optimize`");
+        let mut rest_ids = ids;
+        let (mut nb, mut bb) = (node_base + 1, block_base);
+        let mut parts = Vec::with_capacity(n);
+        for &kid in &kids[..n] {
+            let s = self.size(kid);
+            let (a, r) = std::mem::take(&mut rest_nodes).split_at_mut(s.nodes as usize);
+            rest_nodes = r;
+            let (b, r) = std::mem::take(&mut rest_ids).split_at_mut(s.blocks as usize);
+            rest_ids = r;
+            parts.push((kid, a, nb, b, bb));
+            (nb, bb) = (nb + s.nodes, bb + s.blocks);
         }
-        (idx as u32, depth + 1)
+        let emit = |(kid, a, nb, b, bb): (usize, &mut [Node4], u32, &mut [[u32; 4]], u32)| {
+            self.emit(kid, a, nb, b, bb, depth + 1)
+        };
+        let refs: Vec<(u32, usize)> = if depth < PAR_DEPTH_BVH4 {
+            parts.into_par_iter().map(emit).collect()
+        } else {
+            parts.into_iter().map(emit).collect()
+        };
+        let mut sub = 0;
+        for (slot, (&kid, &(c, d))) in kids[..n].iter().zip(&refs).enumerate() {
+            sub = sub.max(d);
+            let bb = self.bvh2[kid].aabb();
+            for a in 0..3 {
+                node.b[2 * a][slot] = bb.min[a];
+                node.b[2 * a + 1][slot] = bb.max[a];
+            }
+            node.child[slot] = c;
+        }
+        (node_base, sub + 1)
+    }
+}
+
+/// A leaf block as the tests compare it: its triangle ids and vertices.
+#[cfg(test)]
+pub(crate) type Block = ([u32; 4], [[[f32; 4]; 3]; 3]);
+
+#[cfg(test)]
+impl Bvh4 {
+    /// What the build decided besides the nodes, for the tests: root, stack need, and each
+    /// block's triangle ids and vertices.
+    pub(crate) fn built(&self) -> (u32, usize, Vec<Block>) {
+        let blocks = self.ids.iter().zip(&self.tris).map(|(i, t)| (*i, t.v));
+        (self.root, self.stack_need, blocks.collect())
     }
 }

@@ -199,9 +199,10 @@ fn the_collapse_beats_the_greedy_one_on_a_larger_scene() {
 }
 
 /// `binary_bvh` writes PLOC's leaves from the mesh itself instead of a list of boxes: the
-/// `Bvh2` must be the one obvhs' `build_bvh2` makes from those boxes, node for node (sizes
-/// past PLOC's and the sort's parallel and radix thresholds, and the build presets' other
-/// search distances and sort precisions).
+/// `Bvh2` must be the one obvhs' `build_bvh2` makes from those boxes, node for node, on one
+/// thread and on several (sizes past PLOC's and the sort's parallel and radix thresholds and
+/// past one chunk of the parallel passes, and the build presets' other search distances and
+/// sort precisions).
 #[test]
 fn the_lean_binary_build_is_obvhs_build() {
     use obvhs::bvh2::builder::build_bvh2;
@@ -217,20 +218,53 @@ fn the_lean_binary_build_is_obvhs_build() {
                 max_prims_per_leaf: 1,
                 ..params
             };
-            let lean = binary_bvh(&mesh, &spheres, params).unwrap();
             let boxes: Vec<_> = prim_boxes(&mesh, &spheres).collect();
             let full = build_bvh2(&boxes, params, &mut Default::default());
-            assert_eq!(lean.primitive_indices, full.primitive_indices);
-            assert_eq!(lean.nodes.len(), full.nodes.len());
-            for (a, b) in lean.nodes.iter().zip(&full.nodes) {
-                assert_eq!(
-                    (a.aabb().min, a.aabb().max, a.prim_count, a.first_index),
-                    (b.aabb().min, b.aabb().max, b.prim_count, b.first_index)
-                );
+            // The parallel passes on one thread and on several: the same tree.
+            for threads in [1, 3] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let lean = pool.install(|| binary_bvh(&mesh, &spheres, params).unwrap());
+                assert_eq!(lean.primitive_indices, full.primitive_indices);
+                assert_eq!(lean.nodes.len(), full.nodes.len());
+                for (a, b) in lean.nodes.iter().zip(&full.nodes) {
+                    assert_eq!(
+                        (a.aabb().min, a.aabb().max, a.prim_count, a.first_index),
+                        (b.aabb().min, b.aabb().max, b.prim_count, b.first_index)
+                    );
+                }
             }
             if n_tri == 300_000 {
                 break;
             }
         }
+    }
+}
+
+/// The collapse and the emission run subtrees on several threads: the 4-wide BVH (nodes,
+/// their order, blocks) must be the same on one thread and on several, on a tree deeper than
+/// the depths where tasks split.
+#[test]
+fn the_bvh4_is_the_same_on_any_thread_count() {
+    let (mesh, spheres) = scene(60_000, 5, 3);
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| Bvh4::build(&mesh, &spheres, BvhBuildParams::medium_build()).unwrap())
+    };
+    let one = on(1);
+    let (root, stack_need, blocks) = one.built();
+    assert!(stack_need > 3 * 8, "depth {}", stack_need / 3);
+    for threads in [2, 3] {
+        let b = on(threads);
+        assert_eq!(b.nodes.len(), one.nodes.len());
+        for (x, y) in b.nodes.iter().zip(&one.nodes) {
+            assert_eq!((x.b, x.child), (y.b, y.child));
+        }
+        assert_eq!(b.built(), (root, stack_need, blocks.clone()));
     }
 }

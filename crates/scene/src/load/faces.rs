@@ -9,6 +9,7 @@ use crate::error::SceneError;
 use crate::file::{MeshDesc, NormalMode};
 use geom::{TriMesh, smooth_vertex_normals};
 use glam::{DMat3, DMat4, DVec3, Vec2};
+use rayon::prelude::*;
 use std::path::Path;
 
 /// Makes a problem with a mesh file into its error (naming the file and the scene).
@@ -60,7 +61,7 @@ fn dvec3<P: Copy + Into<f64>>(&[x, y, z]: &[P; 3]) -> DVec3 {
 impl Builder<'_> {
     /// `p`'s faces triangulated, its vertices and normals transformed by `xf`, appended to
     /// the scene's mesh. `file` is the mesh file, for warnings.
-    pub(super) fn append_polygons<P: Copy + Into<f64>>(
+    pub(super) fn append_polygons<P: Copy + Into<f64> + Sync>(
         &mut self,
         p: &Polygons<P>,
         desc: &MeshDesc,
@@ -74,38 +75,58 @@ impl Builder<'_> {
         let nxf = DMat3::from_mat4(xf).inverse().transpose();
         let nv = p.positions.len() / 3;
         let mut part = TriMesh::default();
-        for (v, c) in p.positions.as_chunks::<3>().0.iter().enumerate() {
-            let q = dvec3(c);
-            if !q.is_finite() {
-                return Err(oerr(p.at(format!(
-                    "vertex {} is not finite ({:?})",
-                    p.number(v),
-                    q.to_array()
-                ))));
-            }
-            let q = xf.transform_point3(q);
-            if !q.is_finite() || q.abs().max_element() > MAX_COORD {
-                return Err(oerr(p.at(format!(
-                    "vertex {} lies at {:?} after the mesh's transform, beyond the \
+        let corners = p.positions.as_chunks::<3>().0;
+        // Every vertex on every core; the first bad one, if any, is found again below.
+        let placed = |c: &[P; 3]| {
+            let q = xf.transform_point3(dvec3(c));
+            let ok = dvec3(c).is_finite() && q.is_finite() && q.abs().max_element() <= MAX_COORD;
+            ok.then(|| q.as_vec3())
+        };
+        let all = corners.par_iter().map(placed).collect::<Option<Vec<_>>>();
+        let checked = all.is_some();
+        part.positions = all.unwrap_or_default();
+        if !checked {
+            for (v, c) in corners.iter().enumerate() {
+                let q = dvec3(c);
+                if !q.is_finite() {
+                    return Err(oerr(p.at(format!(
+                        "vertex {} is not finite ({:?})",
+                        p.number(v),
+                        q.to_array()
+                    ))));
+                }
+                let q = xf.transform_point3(q);
+                if !q.is_finite() || q.abs().max_element() > MAX_COORD {
+                    return Err(oerr(p.at(format!(
+                        "vertex {} lies at {:?} after the mesh's transform, beyond the \
                      {MAX_COORD:e} scene units photonflow can trace: check the scale",
-                    p.number(v),
-                    q.to_array()
-                ))));
+                        p.number(v),
+                        q.to_array()
+                    ))));
+                }
+                part.positions.push(q.as_vec3());
             }
-            part.positions.push(q.as_vec3());
         }
         if matches!(desc.normals, NormalMode::Auto) && p.normals.len() == 3 * nv {
-            for (v, c) in p.normals.as_chunks::<3>().0.iter().enumerate() {
+            let turned = |c: &[P; 3]| {
                 let n = (nxf * dvec3(c)).normalize_or_zero();
-                if !n.is_finite() || n == DVec3::ZERO {
+                (n.is_finite() && n != DVec3::ZERO).then(|| n.as_vec3())
+            };
+            let normals = p.normals.as_chunks::<3>().0;
+            match normals.par_iter().map(turned).collect::<Option<Vec<_>>>() {
+                Some(all) => part.normals = all,
+                None => {
+                    let v = normals
+                        .iter()
+                        .position(|c| turned(c).is_none())
+                        .unwrap_or(0);
                     return Err(oerr(
                         p.at(format!("normal {} is zero or not finite", p.number(v))),
                     ));
                 }
-                part.normals.push(n.as_vec3());
             }
         }
-        if p.indices.iter().any(|&i| i as usize >= nv) {
+        if p.indices.par_iter().any(|&i| i as usize >= nv) {
             return Err(oerr(p.at("face index out of range".to_string())));
         }
         let mut triangles = Vec::new();

@@ -119,7 +119,6 @@ impl Builder<'_> {
                 ),
             )
         })?;
-        self.hash.write(&bytes);
 
         // tobj asks for MTL files by the name in `mtllib`; read them ourselves so a missing or
         // broken one is reported with its path.
@@ -132,7 +131,13 @@ impl Builder<'_> {
         // Faces come whole and are triangulated here (`polygon`): a fan is wrong for non-convex
         // faces and makes a hopeless BVH of a huge one. The text is read on every core, and the
         // bytes go before the models are formed.
-        let read = objtext::read(&bytes, objtext::CHUNK);
+        // The file's hash (one sequential pass) beside the text's parallel reading: a core
+        // that is done with one turns to the other.
+        let hash = &mut *self.hash;
+        let (read, ()) = rayon::join(
+            || objtext::read(&bytes, objtext::CHUNK),
+            || hash.write(&bytes),
+        );
         drop(bytes);
         let loaded = objtext::form(read, |p: &Path| {
             if !read_mtl {

@@ -41,6 +41,25 @@ fn nan_and_infinite_vertices_are_named() {
 }
 
 #[test]
+fn zero_normals_are_named() {
+    // The third vertex of `floor` (in order of first use) takes the zero normal.
+    let obj = GOOD_OBJ.replace(
+        "f 1 2 3\nf 1 3 4",
+        "vn 0 1 0\nvn 0 0 0\nf 1//1 2//1 3//2\nf 1//1 3//2 4//1",
+    );
+    error_of(
+        "zeronormal",
+        &[
+            ("s.toml", &scene_toml("a.obj")),
+            ("a.obj", &obj),
+            ("m.mtl", GOOD_MTL),
+        ],
+        "a.obj",
+        "object `floor`: normal 3 is zero or not finite",
+    );
+}
+
+#[test]
 fn broken_obj_and_mtl_syntax_are_named() {
     let obj = GOOD_OBJ.replace("f 1 2 3", "f 1 x 3");
     error_of(
