@@ -18,6 +18,7 @@ use crate::{Prim, Ray, Sphere, TriMesh};
 use core::arch::x86_64::*;
 use obvhs::BvhBuildParams;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 
@@ -52,7 +53,7 @@ pub(crate) struct Bvh8 {
     pub(crate) nodes: Vec<Node8>,
     tris: Vec<Tri8>,
     /// Triangle id (in the `TriMesh`) of each lane of `tris`.
-    ids: Vec<[u32; 8]>,
+    pub(crate) ids: Vec<[u32; 8]>,
     pub(crate) root: u32,
     /// Deepest stack a traversal can need (seven pushes per level below the root).
     stack_need: usize,
@@ -78,13 +79,13 @@ impl Bvh8 {
         let bvh2 = binary_bvh(mesh, spheres, params)?;
         let nodes = ploc::compact(bvh2);
         let mut b = Builder8 {
-            choice: vec![0; nodes.len()],
+            choice: (0..nodes.len()).map(|_| AtomicU64::new(0)).collect(),
             bvh2: &nodes,
             n_tri: mesh.len() as u32,
             nodes: Vec::new(),
             ids: Vec::new(),
         };
-        b.optimize(0);
+        b.optimize(0, 0);
         let (root, depth) = b.emit(0);
         let (nodes8, ids) = (b.nodes, b.ids);
         drop(nodes);
@@ -552,11 +553,15 @@ pub(crate) mod avx2 {
 struct Builder8<'a> {
     bvh2: &'a [Node2],
     n_tri: u32,
-    /// Per Bvh2 node, eight choices of eight bits (see `pack`).
-    choice: Vec<u64>,
+    /// Per Bvh2 node, eight choices of eight bits (see `pack`); atomic so that subtrees are
+    /// optimised on several threads (each node is written by one).
+    choice: Vec<AtomicU64>,
     nodes: Vec<Node8>,
     ids: Vec<[u32; 8]>,
 }
+
+/// Bvh2 depth above which `optimize` splits its work between threads.
+const PAR_DEPTH: usize = 12;
 
 #[derive(Clone, Copy)]
 enum Choice {
@@ -593,17 +598,24 @@ fn unpack(p: u64, i: usize) -> Choice {
 
 impl Builder8<'_> {
     /// Primitive count, whether a sphere is under `ni`, and the least cost in 1 to 8 slots.
-    fn optimize(&mut self, ni: usize) -> (u32, bool, [f64; 8]) {
+    /// Subtrees above depth `PAR_DEPTH` run on every core: the choices do not depend on it.
+    fn optimize(&self, ni: usize, depth: usize) -> (u32, bool, [f64; 8]) {
         let node = self.bvh2[ni];
         let area = node.aabb().half_area() as f64;
         let Some((l, r)) = node.children() else {
             let is_sphere = node.prim >= self.n_tri;
             let c = area * if is_sphere { COST_SPHERE } else { COST_BLOCK };
-            self.choice[ni] = pack([Choice::Leaf; 8]);
+            self.choice[ni].store(pack([Choice::Leaf; 8]), Ordering::Relaxed);
             return (1, is_sphere, [c; 8]);
         };
-        let (nl, sl, cl) = self.optimize(l);
-        let (nr, sr, cr) = self.optimize(r);
+        let ((nl, sl, cl), (nr, sr, cr)) = if depth < PAR_DEPTH {
+            rayon::join(
+                || self.optimize(l, depth + 1),
+                || self.optimize(r, depth + 1),
+            )
+        } else {
+            (self.optimize(l, depth + 1), self.optimize(r, depth + 1))
+        };
         let (count, sphere) = (nl + nr, sl || sr);
         let split = |i: usize| {
             (1..i)
@@ -629,12 +641,12 @@ impl Builder8<'_> {
                 (cost[i - 2], Choice::Fewer)
             };
         }
-        self.choice[ni] = pack(choice);
+        self.choice[ni].store(pack(choice), Ordering::Relaxed);
         (count, sphere, cost)
     }
 
     fn forest(&self, ni: usize, i: usize, out: &mut Vec<usize>) {
-        match unpack(self.choice[ni], i) {
+        match unpack(self.choice[ni].load(Ordering::Relaxed), i) {
             Choice::Leaf | Choice::Node(_) => out.push(ni),
             Choice::Fewer => self.forest(ni, i - 1, out),
             Choice::Split(k) => {
@@ -657,7 +669,7 @@ impl Builder8<'_> {
 
     /// Emits subtree `ni` as its one-slot choice; its reference and depth in nodes.
     fn emit(&mut self, ni: usize) -> (u32, usize) {
-        let Choice::Node(k) = unpack(self.choice[ni], 1) else {
+        let Choice::Node(k) = unpack(self.choice[ni].load(Ordering::Relaxed), 1) else {
             let mut prims = Vec::new();
             self.prims(ni, &mut prims);
             if prims[0] >= self.n_tri {

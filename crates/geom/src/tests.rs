@@ -823,3 +823,33 @@ fn ulp_step_is_next_up_or_next_down() {
         }
     }
 }
+
+#[test]
+fn the_same_bvh8_on_any_thread_count() {
+    // `optimize` runs subtrees on several threads; the choices, so the tree, must not change.
+    let Some(isa) = crate::isa::Avx2::detect() else {
+        return; // no AVX2: no BVH8
+    };
+    let geo = test_scene(BvhKind::Bvh4);
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let params = obvhs::BvhBuildParams::medium_build();
+            crate::bvh8::Bvh8::build(geo.mesh(), geo.spheres(), params, isa).unwrap()
+        })
+    };
+    let one = on(1);
+    for threads in [2, 3] {
+        let b = on(threads);
+        assert_eq!((b.root, b.ids.len()), (one.root, one.ids.len()));
+        assert_eq!(b.ids, one.ids);
+        assert_eq!(b.nodes.len(), one.nodes.len());
+        for (x, y) in b.nodes.iter().zip(&one.nodes) {
+            let boxes = |n: &crate::bvh8::Node8| n.b.map(bytemuck::cast::<_, [f32; 8]>);
+            assert_eq!((boxes(x), x.child), (boxes(y), y.child));
+        }
+    }
+}
