@@ -12,15 +12,8 @@ use flow::PipelineOptions;
 use glam::DVec3;
 use vcm::{CameraSplat, LightVertex};
 
-/// Subpaths per chunk of work, at most: a pass ends with a barrier after its light subpaths
-/// and after its eye subpaths, so each phase is cut into at least `8 x threads` chunks (at
-/// 128 x 128, 4096 would leave 4 chunks of unequal cost for 2 threads).
+/// Subpaths per chunk of work.
 const CHUNK: u64 = 4096;
-
-/// The chunk for a phase of `total` subpaths on `threads` workers.
-fn chunk(total: u64, threads: usize) -> u64 {
-    (total / (8 * threads as u64)).clamp(256, CHUNK)
-}
 
 /// The knobs of the `vcm` crate for this run.
 pub(crate) fn options(run: &Run) -> vcm::Options {
@@ -92,10 +85,9 @@ impl<'a> Progressive<'a> {
     ) -> Result<Vec<DVec3>, String> {
         let scene = self.run.scene;
         let p = vcm::Pass::new(scene, self.opts, pass);
-        let threads = self.run.threads();
         let opts = PipelineOptions {
-            chunk: chunk(p.light_paths, threads),
-            ..PipelineOptions::new(threads)
+            chunk: CHUNK,
+            ..PipelineOptions::new(self.run.threads())
         };
         let t0 = std::time::Instant::now();
         let mut sums = vec![DVec3::ZERO; self.image.len()];
@@ -144,10 +136,6 @@ impl<'a> Progressive<'a> {
         let eye =
             |range: std::ops::Range<u64>| (range.start, vcm::eye_paths(scene, &p, &side, range));
         let pixels = self.image.len() as u64;
-        let opts = PipelineOptions {
-            chunk: chunk(pixels, threads),
-            ..opts
-        };
         flow::run_chunks(pixels, &opts, &eye, &mut |(start, px): (
             u64,
             Vec<DVec3>,
