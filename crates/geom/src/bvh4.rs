@@ -228,6 +228,54 @@ fn edges_f64(lanes: u32, x: [F4; 3], y: [F4; 3], e: [F4; 3]) -> [F4; 3] {
 /// Traversal stack entry: child reference and the distance at which the ray enters it.
 type Entry = (u32, f32);
 
+/// Ordered traversal's step at an inner node (Wald et al. 2008, "Getting rid of packets"):
+/// of the children in `mask` (at least one), entered at distances `tn`, returns the nearest
+/// to visit next and pushes the others onto `stack` far to near, ties to the later child.
+/// Shared by the BVH4 and the BVH8 (`crates/geom/src/bvh8.rs`), so both visit in one order.
+#[inline(always)]
+pub(crate) fn visit_ordered(
+    mask: u32,
+    tn: &[f32],
+    child: &[u32],
+    stack: &mut [Entry],
+    sp: &mut usize,
+) -> u32 {
+    if mask & (mask - 1) == 0 {
+        return child[mask.trailing_zeros() as usize];
+    }
+    let rest = mask & (mask - 1);
+    if rest & (rest - 1) == 0 {
+        // Two children, the common case: one comparison.
+        let (i, j) = (
+            mask.trailing_zeros() as usize,
+            rest.trailing_zeros() as usize,
+        );
+        let (near, far) = if tn[i] < tn[j] { (i, j) } else { (j, i) };
+        stack[*sp] = (child[far], tn[far]);
+        *sp += 1;
+        return child[near];
+    }
+    let mut c = [(0u32, 0f32); 8];
+    let mut k = 0;
+    let mut m = mask;
+    while m != 0 {
+        let i = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let e = (child[i], tn[i]);
+        // Insertion sort, farthest first.
+        let mut j = k;
+        while j > 0 && c[j - 1].1 < e.1 {
+            c[j] = c[j - 1];
+            j -= 1;
+        }
+        c[j] = e;
+        k += 1;
+    }
+    stack[*sp..*sp + k - 1].copy_from_slice(&c[..k - 1]);
+    *sp += k - 1;
+    c[k - 1].0
+}
+
 /// Stack size that covers every BVH whose traversal needs at most this many entries;
 /// deeper ones (degenerate input) use a heap stack.
 const INLINE_STACK: usize = 40;
@@ -374,46 +422,7 @@ impl Bvh4 {
                 let n = &self.nodes[cur as usize];
                 let (mask, tn) = r.node(n, best);
                 if mask != 0 {
-                    if mask & (mask - 1) == 0 {
-                        cur = n.child[mask.trailing_zeros() as usize];
-                        continue;
-                    }
-                    // Visit the nearest child first; push the others far to near
-                    // (Wald et al. 2008, "Getting rid of packets", ordered traversal).
-                    let tn = tn.to_array();
-                    let rest = mask & (mask - 1);
-                    if rest & (rest - 1) == 0 {
-                        // Two children, the common case: one comparison.
-                        let (i, j) = (
-                            mask.trailing_zeros() as usize,
-                            rest.trailing_zeros() as usize,
-                        );
-                        // Ties go to the later child, as in the general case's insertion sort.
-                        let (near, far) = if tn[i] < tn[j] { (i, j) } else { (j, i) };
-                        stack[sp] = (n.child[far], tn[far]);
-                        sp += 1;
-                        cur = n.child[near];
-                        continue;
-                    }
-                    let mut c = [(0u32, 0f32); 4];
-                    let mut k = 0;
-                    let mut m = mask;
-                    while m != 0 {
-                        let i = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        let e = (n.child[i], tn[i]);
-                        // Insertion sort, farthest first.
-                        let mut j = k;
-                        while j > 0 && c[j - 1].1 < e.1 {
-                            c[j] = c[j - 1];
-                            j -= 1;
-                        }
-                        c[j] = e;
-                        k += 1;
-                    }
-                    stack[sp..sp + k - 1].copy_from_slice(&c[..k - 1]);
-                    sp += k - 1;
-                    cur = c[k - 1].0;
+                    cur = visit_ordered(mask, &tn.to_array(), &n.child, stack, &mut sp);
                     continue;
                 }
             } else {

@@ -10,7 +10,7 @@
 //! same order, no fused multiply-adds), so a triangle's `t` is the same bits on both paths;
 //! only which of two primitives at an equal `t` wins may differ (the visiting order differs).
 
-use crate::bvh4::{COUNT_SHIFT, EMPTY, LEAF, SPHERE, binary_bvh};
+use crate::bvh4::{COUNT_SHIFT, EMPTY, LEAF, SPHERE, binary_bvh, visit_ordered};
 use crate::float::gamma;
 use crate::isa::Avx2;
 use crate::ploc::{self, Node2};
@@ -437,42 +437,7 @@ pub(crate) mod avx2 {
                 let n = &b.nodes[cur as usize];
                 let (mask, tn) = node!(&r, n, best);
                 if mask != 0 {
-                    if mask & (mask - 1) == 0 {
-                        cur = n.child[mask.trailing_zeros() as usize];
-                        continue;
-                    }
-                    // Nearest child first, the others pushed far to near (Wald et al. 2008).
-                    let tn = lanes(tn);
-                    let rest = mask & (mask - 1);
-                    if rest & (rest - 1) == 0 {
-                        let (i, j) = (
-                            mask.trailing_zeros() as usize,
-                            rest.trailing_zeros() as usize,
-                        );
-                        let (near, far) = if tn[i] < tn[j] { (i, j) } else { (j, i) };
-                        stack[sp] = (n.child[far], tn[far]);
-                        sp += 1;
-                        cur = n.child[near];
-                        continue;
-                    }
-                    let mut c = [(0u32, 0f32); 8];
-                    let mut k = 0;
-                    let mut m = mask;
-                    while m != 0 {
-                        let i = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        let e = (n.child[i], tn[i]);
-                        let mut j = k;
-                        while j > 0 && c[j - 1].1 < e.1 {
-                            c[j] = c[j - 1];
-                            j -= 1;
-                        }
-                        c[j] = e;
-                        k += 1;
-                    }
-                    stack[sp..sp + k - 1].copy_from_slice(&c[..k - 1]);
-                    sp += k - 1;
-                    cur = c[k - 1].0;
+                    cur = visit_ordered(mask, &lanes(tn), &n.child, stack, &mut sp);
                     continue;
                 }
             } else {
