@@ -36,7 +36,7 @@ mod visible;
 pub use film::Class;
 pub use path::{PathOptions, PathTracer, Radiance};
 pub use photon::{Irradiance, MapLookup, render_final_gather, render_global_direct};
-pub use render::{RenderOptions, on_threads, render};
+pub use render::{RenderOptions, on_threads, render, render_into};
 pub use vertices::{EyeVertex, VertexOptions, eye_vertices, pass_seed};
 pub use visible::{PixelSample, VisiblePoint, visible_points};
 

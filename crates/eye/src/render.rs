@@ -85,6 +85,109 @@ pub fn render(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) + Syn
     }
 }
 
+/// [`render`]'s samples added straight to per-pixel sums a progressive run keeps: for each
+/// entry of `classes`, `sums[k][p] += ` the sum of pixel `p`'s samples of that class, the
+/// same f64 values (summed in the same order) as [`render`]'s film holds, for any thread
+/// count. Without a film there is nothing to allocate, merge or copy per pass: rows of pixels
+/// go to the workers, each adding into rows of `sums` it alone holds.
+///
+/// `progress` is called once per finished row with the samples it took.
+///
+/// # Panics
+/// If `opts.spp` is zero, or `sums` is not one image of the camera's size per class.
+pub fn render_into(
+    scene: &Scene,
+    opts: &RenderOptions,
+    classes: &[Class],
+    sums: &mut [Vec<glam::DVec3>],
+    progress: &(dyn Fn(u64) + Sync),
+) {
+    let tracer = PathTracer::new(
+        scene,
+        PathOptions {
+            caustics: opts.caustics,
+            caustic_indirect: opts.caustic_indirect,
+            ..PathOptions::from_scene(scene)
+        },
+    );
+    let slots: Vec<usize> = classes
+        .iter()
+        .map(|c| Class::ALL.iter().position(|a| a == c).unwrap_or(0))
+        .collect();
+    match scene.render().sampler {
+        scene::SamplerKind::Sobol => add_rows(
+            scene,
+            opts,
+            &slots,
+            sums,
+            progress,
+            &|ray, s: &mut SobolSampler| {
+                let l = tracer.li(ray, s);
+                Class::ALL.map(|p| l.get(p))
+            },
+        ),
+        scene::SamplerKind::Independent => add_rows(
+            scene,
+            opts,
+            &slots,
+            sums,
+            progress,
+            &|ray, rng: &mut Rng| {
+                let l = tracer.li(ray, rng);
+                Class::ALL.map(|p| l.get(p))
+            },
+        ),
+    }
+}
+
+/// [`render_into`]'s row loop: `slots[k]` is the sample's entry that `sums[k]` adds.
+fn add_rows<const N: usize, S: PixelSampler>(
+    scene: &Scene,
+    opts: &RenderOptions,
+    slots: &[usize],
+    sums: &mut [Vec<glam::DVec3>],
+    progress: &(dyn Fn(u64) + Sync),
+    sample: &(dyn Fn(geom::Ray, &mut S) -> [glam::Vec3; N] + Sync),
+) {
+    assert!(opts.spp > 0, "render: spp must be positive");
+    let (width, height) = (scene.camera.width as usize, scene.camera.height as usize);
+    assert!(
+        sums.len() == slots.len() && sums.iter().all(|s| s.len() == width * height),
+        "render_into: one {width}x{height} image per class"
+    );
+    let seed = scene.seed();
+    let pixels = (width * height) as u64;
+    let (first, spp) = (opts.first_sample as u64, opts.spp as u64);
+    // Row `y` of every class's sums, so that each worker holds the rows it adds to.
+    let mut rows: Vec<Vec<&mut [glam::DVec3]>> = (0..height).map(|_| Vec::new()).collect();
+    for image in sums.iter_mut() {
+        for (row, r) in rows.iter_mut().zip(image.chunks_mut(width)) {
+            row.push(r);
+        }
+    }
+    let work = || {
+        rows.into_par_iter().enumerate().for_each(|(y, mut row)| {
+            for x in 0..width {
+                let pixel = (y * width + x) as u64;
+                let mut acc = [glam::DVec3::ZERO; N];
+                for s in first..first + spp {
+                    let mut rng = S::for_pixel_sample(seed, pixels, pixel, s);
+                    let [jx, jy] = rng.uniform2();
+                    let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
+                    for (a, v) in acc.iter_mut().zip(sample(ray, &mut rng)) {
+                        *a += v.as_dvec3();
+                    }
+                }
+                for (r, &slot) in row.iter_mut().zip(slots) {
+                    r[x] += acc.get(slot).copied().unwrap_or_default();
+                }
+            }
+            progress(width as u64 * spp);
+        })
+    };
+    on_threads(opts.threads, work);
+}
+
 /// How the tile loop makes the sampler of pixel sample `s` of pixel `p` (of `pixels`).
 pub(crate) trait PixelSampler: Sampler + Sized {
     fn for_pixel_sample(seed: u64, pixels: u64, pixel: u64, s: u64) -> Self;

@@ -79,6 +79,8 @@ pub struct Geometry {
     bounds: Bounds3,
     /// Seconds the index took to build (for `bench-load`).
     build_seconds: f64,
+    /// Per sphere: whether its hits compute `uv` (see [`Geometry::set_sphere_uv`]).
+    sphere_uv: Vec<bool>,
 }
 
 impl Geometry {
@@ -89,6 +91,7 @@ impl Geometry {
 
     pub fn with_bvh(mesh: TriMesh, spheres: Vec<Sphere>, kind: BvhKind) -> Geometry {
         let start = std::time::Instant::now();
+        let spheres_len = spheres.len();
         let kind = match (kind, Avx2::detect()) {
             (BvhKind::Bvh8, None) => BvhKind::Bvh4,
             (k, _) => k,
@@ -151,7 +154,15 @@ impl Geometry {
             rt_ids: order,
             bounds,
             build_seconds: start.elapsed().as_secs_f64(),
+            sphere_uv: vec![true; spheres_len],
         }
+    }
+
+    /// Which spheres' hits carry their `uv`, by material: a sphere's `(phi, theta)` costs an
+    /// atan2 and an acos per hit that only a texture reads. Every sphere has it until this
+    /// is called; the others' hits then carry zeros.
+    pub fn set_sphere_uv(&mut self, needs_uv: impl Fn(u32) -> bool) {
+        self.sphere_uv = self.spheres.iter().map(|s| needs_uv(s.material)).collect();
     }
 
     /// The structure that was built (`Bvh8` asked for without AVX2 builds a `Bvh4`).
@@ -309,7 +320,8 @@ impl Geometry {
 
     fn sphere_hit(&self, ray: &Ray, i: u32, t: f32) -> Hit {
         let s = &self.spheres[i as usize];
-        let (point, uv) = s.surface_point(ray, t);
+        let uv = self.sphere_uv.get(i as usize).copied().unwrap_or(true);
+        let (point, uv) = s.surface_point(ray, t, uv);
         Hit {
             t,
             point,

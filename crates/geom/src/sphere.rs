@@ -48,25 +48,18 @@ impl Sphere {
 
     /// Surface point for a hit at `t`: re-projected onto the sphere (pbrt-v4 §6.8.5) and
     /// rounded to f32 once, so the error is a rounding of each component plus the
-    /// re-projection's few operations.
-    pub fn surface_point(&self, ray: &Ray, t: f32) -> (SurfacePoint, [f32; 2]) {
+    /// re-projection's few operations. With `uv`, also the hit's parameterisation `(phi / 2pi,
+    /// theta / pi)` (else zeros): an atan2 and an acos in f64, which only textured spheres
+    /// need.
+    #[inline]
+    pub fn surface_point(&self, ray: &Ray, t: f32, uv: bool) -> (SurfacePoint, [f32; 2]) {
         let c = self.center.as_dvec3();
         let r = self.radius as f64;
         let ph = ray.o.as_dvec3() + t as f64 * ray.d.as_dvec3() - c;
         let n = ph.normalize_or(DVec3::Y);
         let p = (c + n * r).as_vec3();
         let p_err = gamma(5) * (n * r).abs().as_vec3() + gamma(2) * p.abs();
-        let phi = n.z.atan2(n.x);
-        let phi = if phi < 0.0 {
-            phi + std::f64::consts::TAU
-        } else {
-            phi
-        };
-        let theta = n.y.clamp(-1.0, 1.0).acos();
-        let uv = [
-            (phi / std::f64::consts::TAU) as f32,
-            (theta / std::f64::consts::PI) as f32,
-        ];
+        let uv = if uv { Sphere::uv(n) } else { [0.0; 2] };
         (
             SurfacePoint {
                 p,
@@ -75,5 +68,20 @@ impl Sphere {
             },
             uv,
         )
+    }
+
+    /// `(phi / 2pi, theta / pi)` of the outward unit normal `n`.
+    fn uv(n: DVec3) -> [f32; 2] {
+        let phi = n.z.atan2(n.x);
+        let phi = if phi < 0.0 {
+            phi + std::f64::consts::TAU
+        } else {
+            phi
+        };
+        let theta = n.y.clamp(-1.0, 1.0).acos();
+        [
+            (phi / std::f64::consts::TAU) as f32,
+            (theta / std::f64::consts::PI) as f32,
+        ]
     }
 }

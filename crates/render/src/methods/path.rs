@@ -119,8 +119,15 @@ impl<'a> Progressive<'a> {
 
     /// Renders the next `n` samples of every pixel and adds them.
     pub(super) fn step(&mut self, n: u32, progress: &(dyn Fn(u64) + Sync)) -> Result<(), String> {
-        let block = self.block(self.samples..self.samples + n, progress)?;
-        self.add(&block, n);
+        let opts = eye::RenderOptions {
+            spp: n,
+            first_sample: self.samples,
+            ..self.opts
+        };
+        // Straight into the sums: the same values as `block` then `add`, without a film.
+        eye::render_into(self.run.scene, &opts, &self.parts, &mut self.sums, progress);
+        self.samples += n;
+        self.blocks += 1;
         Ok(())
     }
 

@@ -222,10 +222,17 @@ impl<'a> Builder<'a> {
         let camera = self.camera(&file)?;
         let (lights, light_table) = self.lights(&file)?;
         // The hashes need the whole scene text: `Scene::from_toml` sets them.
+        let mut geometry = Geometry::new(self.mesh, self.spheres);
+        // Only a textured sphere reads its hits' `uv` (`Scene::texcoord`).
+        geometry.set_sphere_uv(|m| {
+            self.albedo_maps
+                .get(m as usize)
+                .is_some_and(Option::is_some)
+        });
         Ok(Scene {
             path: self.scene_path.to_path_buf(),
             file,
-            geometry: Geometry::new(self.mesh, self.spheres),
+            geometry,
             bsdfs: self.materials.iter().map(crate::world::bsdf_of).collect(),
             albedo_maps: self.albedo_maps,
             textures: self.textures,

@@ -285,3 +285,59 @@ fn missing_or_broken_textures_are_named() {
         "{e}"
     );
 }
+
+#[test]
+fn textured_spheres_read_their_texture_at_phi_and_theta() {
+    // A checkerboard sphere beside a plain one. The textured sphere's uv is
+    // `(phi / 2pi, theta / pi)` of its normal (phi from +x towards +z in [0, 2pi), theta from
+    // +y); the checkerboard is `color0` where the fractional parts of u and 1 - v (Mitsuba's
+    // v runs down) are both below one half or both above it. The plain sphere's hits skip
+    // the uv (an atan2 and an acos per hit).
+    let toml = format!(
+        "{}[[sphere]]\ncenter = [0.0, 5.0, 0.0]\nradius = 1.0\nmaterial = \"checks\"\n\
+         [[sphere]]\ncenter = [4.0, 5.0, 0.0]\nradius = 1.0\nmaterial = \"plain\"\n\
+         [material.checks]\ntype = \"lambertian\"\nalbedo = [1.0, 1.0, 1.0]\n\
+         texture = {{ type = \"checkerboard\", color0 = [0.1, 0.2, 0.3], color1 = [0.7, 0.8, 0.9] }}\n\
+         [material.plain]\ntype = \"lambertian\"\nalbedo = [0.5, 0.5, 0.5]\n",
+        scene_toml("a.obj")
+    );
+    let dir = Scratch::new(
+        "sphere-uv",
+        &[("s.toml", &toml), ("a.obj", GOOD_OBJ), ("m.mtl", GOOD_MTL)],
+    );
+    let s = Scene::load(dir.path("s.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let centre = Vec3::new(0.0, 5.0, 0.0);
+    let (c0, c1) = (Vec3::new(0.1, 0.2, 0.3), Vec3::new(0.7, 0.8, 0.9));
+    // Normals and their (u, v), worked out by hand: (0.046, 0.358), (0.546, 0.358), (0.046,
+    // 0.642), (0.546, 0.642).
+    for (n, want) in [
+        (Vec3::new(1.0, 0.5, 0.3), c1),
+        (Vec3::new(-1.0, 0.5, -0.3), c0),
+        (Vec3::new(1.0, -0.5, 0.3), c0),
+        (Vec3::new(-1.0, -0.5, -0.3), c1),
+    ] {
+        let n = n.normalize();
+        let ray = geom::Ray::new(centre + 3.0 * n, -n);
+        let hit = s.geometry.intersect(&ray).expect("the textured sphere");
+        let phi = (n.z as f64)
+            .atan2(n.x as f64)
+            .rem_euclid(std::f64::consts::TAU);
+        let theta = (n.y as f64).acos();
+        let uv = [phi / std::f64::consts::TAU, theta / std::f64::consts::PI];
+        assert!(
+            (hit.uv[0] as f64 - uv[0]).abs() < 1e-5 && (hit.uv[1] as f64 - uv[1]).abs() < 1e-5,
+            "{n}: uv {:?} != {uv:?}",
+            hit.uv
+        );
+        let albedo = s.bsdf_at(&hit).and_then(|b| b.diffuse_albedo()).unwrap();
+        assert!(close(albedo, want, 1e-6), "{n}: {albedo} != {want}");
+    }
+    let plain = geom::Ray::new(Vec3::new(4.0, 8.0, 0.0), Vec3::NEG_Y);
+    let hit = s.geometry.intersect(&plain).expect("the plain sphere");
+    assert_eq!(hit.uv, [0.0, 0.0]);
+    assert!(close(
+        s.bsdf_at(&hit).and_then(|b| b.diffuse_albedo()).unwrap(),
+        Vec3::splat(0.5),
+        1e-6
+    ));
+}
