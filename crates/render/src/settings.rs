@@ -39,7 +39,7 @@ pub struct VcmSettings {
     /// of `(seed, j, i)`; the image is their mean. A time budget sets the passes it made.
     pub passes: u32,
     /// Light subpaths per pass (0: one per pixel). Pixel `i`'s eye path connects to light
-    /// path `i`; every light path is joined to the camera and merged.
+    /// path `i` modulo their number; every light path is joined to the camera and merged.
     pub light_paths: u64,
     /// Merging radius of the first pass in scene units (0: a pixel's footprint at the
     /// distance from the camera to the scene's centre).

@@ -54,7 +54,9 @@ fn pixel(scene: &Scene, pass: &Pass, light: &LightSide, index: u64) -> DVec3 {
         let e = light.starts.get(i as usize + 1).copied().unwrap_or(0) as usize;
         light.vertices.get(s..e).unwrap_or(&[])
     };
-    let own = range(index);
+    // Fewer light paths than pixels: pixel `i` joins light path `i mod N`, so every eye path
+    // still has one independent light subpath to connect to, as the weights assume.
+    let own = range(index % pass.light_paths.max(1));
     loop {
         let Some(hit) = scene.geometry.intersect(&ray) else {
             if on.hits {

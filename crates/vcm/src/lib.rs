@@ -85,7 +85,7 @@ pub struct Options {
     /// Russian roulette from this many bounces on, on both subpaths.
     pub rr_depth: u32,
     /// Light subpaths per pass (0: one per pixel). Pixel `i`'s eye path connects to light
-    /// path `i`; every light path is joined to the camera and merged.
+    /// path `i` modulo their number; every light path is joined to the camera and merged.
     pub light_paths: u64,
     /// Merging radius of the first pass, in scene units.
     pub radius: f32,
