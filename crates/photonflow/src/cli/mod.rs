@@ -21,8 +21,8 @@ use scene::Method;
 /// Photon-mapping renderer.
 ///
 /// Every parameter of a run lives in its scene file; flags only override it. `cargo xtask
-/// <command>` builds this binary in release and runs it (`cargo xtask bench <what>` runs
-/// `bench-<what>` and records its output). `photonflow <command> --help` gives a command's
+/// <command>` builds this binary with the `release-lto` profile, the one benchmarks measure,
+/// and runs it (`cargo xtask bench <what>` runs `bench-<what>` and records its output). `photonflow <command> --help` gives a command's
 /// details; docs/commands.md collects them all.
 #[derive(Parser)]
 #[command(name = "photonflow", version)]
