@@ -56,33 +56,36 @@ impl RenderOptions {
 /// # Panics
 /// If `opts.spp` or `opts.tile` is zero (callers validate settings first).
 pub fn render(scene: &Scene, opts: &RenderOptions, progress: &(dyn Fn(u64) + Sync)) -> Film {
-    let tracer = PathTracer::new(
+    let tracer = tracer(scene, opts);
+    let names = Class::ALL.map(Class::name);
+    match scene.render().sampler {
+        scene::SamplerKind::Sobol => render_layers(scene, opts, names, progress, &|ray, s| {
+            by_class::<SobolSampler>(&tracer, ray, s)
+        }),
+        scene::SamplerKind::Independent => {
+            render_layers(scene, opts, names, progress, &|ray, s| {
+                by_class::<Rng>(&tracer, ray, s)
+            })
+        }
+    }
+}
+
+/// The path tracer of one eye pass.
+fn tracer<'a>(scene: &'a Scene, opts: &RenderOptions) -> PathTracer<'a> {
+    PathTracer::new(
         scene,
         PathOptions {
             caustics: opts.caustics,
             caustic_indirect: opts.caustic_indirect,
             ..PathOptions::from_scene(scene)
         },
-    );
-    let names = Class::ALL.map(Class::name);
-    match scene.render().sampler {
-        scene::SamplerKind::Sobol => render_layers(
-            scene,
-            opts,
-            names,
-            progress,
-            &|ray, s: &mut SobolSampler| {
-                let l = tracer.li(ray, s);
-                Class::ALL.map(|p| l.get(p))
-            },
-        ),
-        scene::SamplerKind::Independent => {
-            render_layers(scene, opts, names, progress, &|ray, rng: &mut Rng| {
-                let l = tracer.li(ray, rng);
-                Class::ALL.map(|p| l.get(p))
-            })
-        }
-    }
+    )
+}
+
+/// One sample's radiance per class, in [`Class::ALL`] order.
+fn by_class<S: Sampler>(tracer: &PathTracer, ray: geom::Ray, s: &mut S) -> [glam::Vec3; 5] {
+    let l = tracer.li(ray, s);
+    Class::ALL.map(|p| l.get(p))
 }
 
 /// [`render`]'s samples added straight to per-pixel sums a progressive run keeps: for each
@@ -102,42 +105,45 @@ pub fn render_into(
     sums: &mut [Vec<glam::DVec3>],
     progress: &(dyn Fn(u64) + Sync),
 ) {
-    let tracer = PathTracer::new(
-        scene,
-        PathOptions {
-            caustics: opts.caustics,
-            caustic_indirect: opts.caustic_indirect,
-            ..PathOptions::from_scene(scene)
-        },
-    );
+    let tracer = tracer(scene, opts);
     let slots: Vec<usize> = classes
         .iter()
         .map(|c| Class::ALL.iter().position(|a| a == c).unwrap_or(0))
         .collect();
     match scene.render().sampler {
-        scene::SamplerKind::Sobol => add_rows(
-            scene,
-            opts,
-            &slots,
-            sums,
-            progress,
-            &|ray, s: &mut SobolSampler| {
-                let l = tracer.li(ray, s);
-                Class::ALL.map(|p| l.get(p))
-            },
-        ),
-        scene::SamplerKind::Independent => add_rows(
-            scene,
-            opts,
-            &slots,
-            sums,
-            progress,
-            &|ray, rng: &mut Rng| {
-                let l = tracer.li(ray, rng);
-                Class::ALL.map(|p| l.get(p))
-            },
-        ),
+        scene::SamplerKind::Sobol => add_rows(scene, opts, &slots, sums, progress, &|ray, s| {
+            by_class::<SobolSampler>(&tracer, ray, s)
+        }),
+        scene::SamplerKind::Independent => {
+            add_rows(scene, opts, &slots, sums, progress, &|ray, s| {
+                by_class::<Rng>(&tracer, ray, s)
+            })
+        }
     }
+}
+
+/// The sums of samples `range` of pixel `(x, y)`, per entry of `sample`'s result, in sample
+/// order: pixel sample `s` draws from [`PixelSampler::for_pixel_sample`]'s sampler, two
+/// numbers for its jitter first.
+fn pixel_sums<const N: usize, S: PixelSampler>(
+    scene: &Scene,
+    seed: u64,
+    pixels: u64,
+    (x, y): (usize, usize),
+    range: std::ops::Range<u64>,
+    sample: &(dyn Fn(geom::Ray, &mut S) -> [glam::Vec3; N] + Sync),
+) -> [glam::DVec3; N] {
+    let pixel = (y * scene.camera.width as usize + x) as u64;
+    let mut sums = [glam::DVec3::ZERO; N];
+    for s in range {
+        let mut rng = S::for_pixel_sample(seed, pixels, pixel, s);
+        let [jx, jy] = rng.uniform2();
+        let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
+        for (sum, v) in sums.iter_mut().zip(sample(ray, &mut rng)) {
+            *sum += v.as_dvec3();
+        }
+    }
+    sums
 }
 
 /// [`render_into`]'s row loop: `slots[k]` is the sample's entry that `sums[k]` adds.
@@ -168,16 +174,7 @@ fn add_rows<const N: usize, S: PixelSampler>(
     let work = || {
         rows.into_par_iter().enumerate().for_each(|(y, mut row)| {
             for x in 0..width {
-                let pixel = (y * width + x) as u64;
-                let mut acc = [glam::DVec3::ZERO; N];
-                for s in first..first + spp {
-                    let mut rng = S::for_pixel_sample(seed, pixels, pixel, s);
-                    let [jx, jy] = rng.uniform2();
-                    let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
-                    for (a, v) in acc.iter_mut().zip(sample(ray, &mut rng)) {
-                        *a += v.as_dvec3();
-                    }
-                }
+                let acc = pixel_sums(scene, seed, pixels, (x, y), first..first + spp, sample);
                 for (r, &slot) in row.iter_mut().zip(slots) {
                     r[x] += acc.get(slot).copied().unwrap_or_default();
                 }
@@ -265,17 +262,7 @@ fn render_tile<const N: usize, S: PixelSampler>(
     let mut buf = film.tile_buffer(rect);
     for y in rect.y0..rect.y1 {
         for x in rect.x0..rect.x1 {
-            let pixel = (y * width + x) as u64;
-            let mut sums = [glam::DVec3::ZERO; N];
-            for s in first..first + spp {
-                let mut rng = S::for_pixel_sample(seed, pixels, pixel, s);
-                let [jx, jy] = rng.uniform2();
-                let ray = scene.camera.ray(x as f32 + jx, y as f32 + jy);
-                let l = sample(ray, &mut rng);
-                for (sum, v) in sums.iter_mut().zip(l) {
-                    *sum += v.as_dvec3();
-                }
-            }
+            let sums = pixel_sums(scene, seed, pixels, (x, y), first..first + spp, sample);
             for (name, sum) in names.iter().zip(sums) {
                 let layer = buf.layer_mut(name);
                 layer.add_f64(x, y, sum.to_array());
