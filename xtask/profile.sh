@@ -77,10 +77,11 @@ categorise() {
         if (fn_ ~ /warp::/)                                         return "warps"
         if (fn_ ~ /camera/)                                         return "camera"
         if (fn_ ~ /film::|render_tile|TileBuffer/)                  return "film"
+        # Library code (glam, core) inlined into the path loop (`PathTracer::li`) or the
+        # sample loop around it, whose own calls (BSDFs, lights, camera) are inlined there
+        # too: not attributable by file.
+        if (fn_ ~ /PathTracer::li|eye::render::/)                   return "inlined-math"
         if (fn_ ~ /PathTracer|eye::path/)                           return "integrator"
-        # Library code (glam, core) inlined into the sample loop, whose own calls (the path
-        # tracer, BSDFs, lights, camera) are inlined there too: not attributable by file.
-        if (fn_ ~ /eye::render::render::\{\{closure\}\}/)             return "inlined-math"
         return "other"
     }
     # Lines: "  1,234,567 (1.25%)  file:function" (callgrind_annotate --inclusive=no --auto=no).
