@@ -185,6 +185,50 @@ fn int(s: &str) -> Option<i64> {
     s.parse::<isize>().ok().map(|x| x as i64)
 }
 
+/// A word of decimal digits with at most one `.` and an optional sign, as `f32::from_str`
+/// reads it, or `None` for anything else (an exponent, `inf`, more digits than below), which
+/// the general path reads. Clinger's fast path: a significand below 2^24 and a power of ten
+/// up to 10^10 are both exact in f32, so their quotient is the correctly rounded value, as
+/// std's (correctly rounding) parser gives it.
+pub(crate) fn decimal(w: &[u8]) -> Option<f32> {
+    let (neg, digits) = match w {
+        [b'-', rest @ ..] => (true, rest),
+        [b'+', rest @ ..] => (false, rest),
+        _ => (false, w),
+    };
+    if digits.is_empty() || digits.len() > 12 {
+        return None;
+    }
+    let (mut m, mut scale, mut dot, mut any) = (0u64, 0usize, false, false);
+    for &c in digits {
+        match c {
+            b'0'..=b'9' => {
+                m = m * 10 + (c - b'0') as u64;
+                scale += dot as usize;
+                any = true;
+            }
+            b'.' if !dot => dot = true,
+            _ => return None,
+        }
+    }
+    const TEN: [f32; 11] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10];
+    let &p = TEN.get(scale)?;
+    if !any || m > 1 << 24 {
+        return None;
+    }
+    let x = m as f32 / p;
+    Some(if neg { -x } else { x })
+}
+
+/// A position index of 1 to 9 digits (no sign, not 0), as [`Chunk::corner`] resolves it.
+fn index(w: &[u8]) -> Option<u32> {
+    if w.is_empty() || w.len() > 9 || !w.iter().all(u8::is_ascii_digit) {
+        return None;
+    }
+    let x = w.iter().fold(0u32, |a, &d| a * 10 + (d - b'0') as u32);
+    x.checked_sub(1)
+}
+
 /// A resolved index as tobj's `usize` (`(count + x) as usize` for negative `x`).
 fn as_index(x: i64) -> u64 {
     x as u64
@@ -253,8 +297,57 @@ impl Chunk {
         true
     }
 
+    /// A plain `v x y z` or `f a b c ...` line (ASCII spaces or tabs between words, simple
+    /// decimals, positive indices, no texture or normal index in the chunk so far) read
+    /// without the general path's word splitting and parsing: most of a large file. `false`
+    /// leaves the chunk as it was, for [`Chunk::line`]'s general reading.
+    fn plain(&mut self, line: &[u8]) -> bool {
+        let blank = |c: &u8| *c == b' ' || *c == b'\t';
+        let (kind, rest) = match line {
+            [k @ (b'v' | b'f'), c, rest @ ..] if blank(c) => (*k, rest),
+            _ => return false,
+        };
+        let mut words = rest.split(blank).filter(|w| !w.is_empty());
+        if kind == b'v' {
+            let mut xyz = [0.0f32; 3];
+            for x in &mut xyz {
+                match words.next().and_then(decimal) {
+                    Some(v) => *x = v,
+                    None => return false,
+                }
+            }
+            if words.next().is_some() {
+                return false;
+            }
+            self.pos.extend_from_slice(&xyz);
+        } else {
+            if !(self.vt.is_empty() && self.vn.is_empty()) {
+                return false;
+            }
+            let before = self.v.len();
+            for w in words {
+                match index(w) {
+                    Some(v) => self.v.push(v),
+                    None => {
+                        self.v.truncate(before);
+                        return false;
+                    }
+                }
+            }
+            if self.v.len() == before {
+                return false;
+            }
+            self.arity.push((self.v.len() - before) as u32);
+        }
+        self.nonblank += 1;
+        true
+    }
+
     /// One line; `Err` stops the chunk.
     fn line(&mut self, n: usize, line: &str) -> Result<(), LoadError> {
+        if self.plain(line.as_bytes()) {
+            return Ok(());
+        }
         let mut w = Words { rest: line };
         let Some(first) = w.next() else {
             return Ok(());

@@ -47,6 +47,9 @@ const CASES: &[&str] = &[
     "\n\n",
     "f 1 2 3\n",
     "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1\nf 1 2 3\nf 3/1 2 1/1\n",
+    "v -0.999000 +0.212345\t-1.000000\nv 16777216 16777217 .5\nv 5. 0.1234567890123 -0.0\nf 1 2 3\nf\t3  2 1 \n",
+    "v 1 2 3\nv 4 5 6\nv 7 8 9\nf 1 2 -1\nf 1 2 3\nvn 0 0 1\nf 1 2 3\nf 1//1 2//1 3//1\nf 3 2 1\n",
+    "v 1 2 3\nv 4 5 6\nv 7 8 9\nf 1 2 000000003\nf 1 2 0003\nf 1 2 1234567890\nf 1 2 .3\n",
 ];
 
 /// The MTL files the cases name.
@@ -169,6 +172,73 @@ fn every_case_reads_as_tobj_reads_it() {
     for case in CASES {
         check(case.as_bytes());
     }
+}
+
+/// The quick decimal reading gives std's value, bit for bit, or leaves the word to std.
+#[test]
+fn quick_decimals_are_std_decimals() {
+    let mut words: Vec<String> = [
+        "0",
+        "-0",
+        "+0",
+        "1",
+        "-1.",
+        ".5",
+        "-.5",
+        "5.",
+        ".",
+        "-",
+        "+",
+        "",
+        "1.2.3",
+        "1e3",
+        "inf",
+        "nan",
+        "0x1",
+        "16777216",
+        "16777217",
+        "0.0000000001",
+        "0.00000000001",
+        "123456789012",
+        "1234567890123",
+        "9999999.9",
+        "0.1",
+        "0.3",
+        "3.4028235",
+        "--1",
+        "1-",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    for _ in 0..200_000 {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        let digits = (state % 13) as usize;
+        let dot = (state >> 8) as usize % (digits + 2);
+        let mut w = String::new();
+        if state >> 20 & 1 == 1 {
+            w.push('-');
+        }
+        for i in 0..digits {
+            if i == dot {
+                w.push('.');
+            }
+            w.push(char::from(b'0' + ((state >> (24 + 3 * i)) % 10) as u8));
+        }
+        words.push(w);
+    }
+    let mut quick = 0;
+    for w in &words {
+        if let Some(x) = objtext::decimal(w.as_bytes()) {
+            quick += 1;
+            let std: f32 = w.parse().unwrap_or_else(|_| panic!("{w:?} is no f32"));
+            assert_eq!(x.to_bits(), std.to_bits(), "{w:?}");
+        }
+    }
+    assert!(quick > words.len() / 3, "{quick} of {}", words.len());
 }
 
 /// Mutations of the cases (bytes replaced, inserted, deleted, lines swapped, a token from
