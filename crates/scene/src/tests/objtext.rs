@@ -98,7 +98,19 @@ fn by_tobj(bytes: &[u8]) -> Outcome {
 type Directives = (Vec<(usize, String)>, usize);
 
 fn by_objtext(bytes: &[u8], chunk: usize) -> (Outcome, Option<Directives>) {
-    match objtext::form(objtext::read(bytes, chunk), mtl) {
+    by_objtext_with(bytes, chunk, objtext::PARALLEL)
+}
+
+/// [`by_objtext`] with the parallel numbering taking models from `par.min_corners` corners,
+/// in tasks of `par.block`.
+fn by_objtext_with(
+    bytes: &[u8],
+    chunk: usize,
+    par: objtext::Parallel,
+) -> (Outcome, Option<Directives>) {
+    let mut read = objtext::read(bytes, chunk);
+    read.1 = par;
+    match objtext::form(read, mtl) {
         Ok(t) => (
             Ok((
                 t.models,
@@ -154,11 +166,22 @@ fn same(a: &Outcome, b: &Outcome) -> bool {
 
 fn check(bytes: &[u8]) {
     let want = by_tobj(bytes);
-    for chunk in [1, 3, 17, objtext::CHUNK] {
-        let (got, dirs) = by_objtext(bytes, chunk);
+    // Every model numbered in parallel (where it can be), in tasks of 1, 2 and 5 corners.
+    let par = |block| objtext::Parallel {
+        min_corners: 0,
+        block,
+    };
+    for (chunk, par) in [
+        (1, objtext::PARALLEL),
+        (3, par(2)),
+        (17, par(1)),
+        (objtext::CHUNK, objtext::PARALLEL),
+        (objtext::CHUNK, par(5)),
+    ] {
+        let (got, dirs) = by_objtext_with(bytes, chunk, par);
         assert!(
             same(&got, &want),
-            "chunk {chunk}, file {:?}:\n ours {got:?}\n tobj {want:?}",
+            "chunk {chunk}, {par:?}, file {:?}:\n ours {got:?}\n tobj {want:?}",
             String::from_utf8_lossy(bytes)
         );
         if let Some(d) = dirs {
@@ -300,4 +323,43 @@ fn a_file_over_many_chunks_reads_as_one() {
         models.iter().map(|m| m.indices.len()).sum::<usize>(),
         2 * 2998 * 3
     );
+}
+
+/// Large plain models (no texture or normal index) numbered in parallel: triangles, quads,
+/// points and lines, faces across chunk boundaries, relative indices, an index out of range;
+/// as tobj reads them, on 1, 2 and 3 threads.
+#[test]
+fn plain_models_numbered_in_parallel_read_as_tobj_reads_them() {
+    let mut s = String::from("mtllib m.mtl\nusemtl red\n");
+    for i in 0..4000 {
+        s += &format!("v {i} {} 0.5\n", i % 7);
+        if i >= 3 {
+            // Faces from the back (first use out of order) and points and lines between.
+            s += &format!("f {} {} {}\nf -1 -3 -2\n", i + 1, i - 2, i);
+            match i % 500 {
+                7 => s += &format!("f {} {} {} {}\np {i}\nl 1 {i}\n", i - 2, i - 1, i, i + 1),
+                11 => s += "g next\nusemtl white\n",
+                _ => {}
+            }
+        }
+    }
+    let bad = s.replacen("f 2000 ", "f 99999 ", 1);
+    assert!(bad != s);
+    for text in [&s, &bad] {
+        let want = by_tobj(text.as_bytes());
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            for block in [1, 7, 1 << 16] {
+                let par = objtext::Parallel {
+                    min_corners: 64,
+                    block,
+                };
+                let (got, _) = pool.install(|| by_objtext_with(text.as_bytes(), 1000, par));
+                assert!(same(&got, &want), "{threads} threads, {par:?}");
+            }
+        }
+    }
 }
