@@ -1,14 +1,15 @@
 //! What every mesh file shares once read: its vertices checked finite and put through the
 //! mesh's transform, its normals through the inverse transpose (or replaced by `normals`),
 //! its texture coordinates kept, its polygons triangulated (`polygon.rs`), turned over by
-//! `flip_normals`, and appended to the scene's mesh. `obj.rs` and `ply.rs` each read their format into a [`Polygons`] and hand
-//! it here, so both formats load the same faces the same way.
+//! `flip_normals`, and written into the scene's mesh (on every core, with no copy of the
+//! part). `obj.rs` and `ply.rs` each read their format into a [`Polygons`] and hand it here,
+//! so both formats load the same faces the same way.
 
 use super::{Builder, MAX_COORD};
 use crate::error::SceneError;
 use crate::file::{MeshDesc, NormalMode};
-use geom::{TriMesh, smooth_vertex_normals};
-use glam::{DMat3, DMat4, DVec3, Vec2};
+use geom::smooth_vertex_normals;
+use glam::{DMat3, DMat4, DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -74,18 +75,22 @@ impl Builder<'_> {
         }
         let nxf = DMat3::from_mat4(xf).inverse().transpose();
         let nv = p.positions.len() / 3;
-        let mut part = TriMesh::default();
+        // The part is written straight into the scene's mesh on every core: no copy of it is
+        // made, and no part of the mesh is moved. An error ends the load, so a part left half
+        // written is never seen.
+        let mesh = &mut self.mesh;
+        let base = mesh.positions.len();
         let corners = p.positions.as_chunks::<3>().0;
-        // Every vertex on every core; the first bad one, if any, is found again below.
         let placed = |c: &[P; 3]| {
             let q = xf.transform_point3(dvec3(c));
             let ok = dvec3(c).is_finite() && q.is_finite() && q.abs().max_element() <= MAX_COORD;
             ok.then(|| q.as_vec3())
         };
-        let all = corners.par_iter().map(placed).collect::<Option<Vec<_>>>();
-        let checked = all.is_some();
-        part.positions = all.unwrap_or_default();
-        if !checked {
+        // A vertex that fails is NaN here (no placed vertex is) and found again below.
+        let nan = Vec3::splat(f32::NAN);
+        (mesh.positions).par_extend(corners.par_iter().map(|c| placed(c).unwrap_or(nan)));
+        let positions = mesh.positions.get(base..).unwrap_or_default();
+        if positions.par_iter().any(|q| q.x.is_nan()) {
             for (v, c) in corners.iter().enumerate() {
                 let q = dvec3(c);
                 if !q.is_finite() {
@@ -104,36 +109,28 @@ impl Builder<'_> {
                         q.to_array()
                     ))));
                 }
-                part.positions.push(q.as_vec3());
             }
         }
+        let mut normals = Vec::new();
         if matches!(desc.normals, NormalMode::Auto) && p.normals.len() == 3 * nv {
             let turned = |c: &[P; 3]| {
                 let n = (nxf * dvec3(c)).normalize_or_zero();
                 (n.is_finite() && n != DVec3::ZERO).then(|| n.as_vec3())
             };
-            let normals = p.normals.as_chunks::<3>().0;
-            match normals.par_iter().map(turned).collect::<Option<Vec<_>>>() {
-                Some(all) => part.normals = all,
-                None => {
-                    let v = normals
-                        .iter()
-                        .position(|c| turned(c).is_none())
-                        .unwrap_or(0);
-                    return Err(oerr(
-                        p.at(format!("normal {} is zero or not finite", p.number(v))),
-                    ));
-                }
+            let given = p.normals.as_chunks::<3>().0;
+            normals = given.par_iter().map(|c| turned(c).unwrap_or(nan)).collect();
+            if let Some(v) = normals.par_iter().position_first(|n| n.x.is_nan()) {
+                return Err(oerr(
+                    p.at(format!("normal {} is zero or not finite", p.number(v))),
+                ));
             }
         }
         if p.indices.par_iter().any(|&i| i as usize >= nv) {
             return Err(oerr(p.at("face index out of range".to_string())));
         }
-        let mut triangles = Vec::new();
-        if p.arities.is_empty() {
-            // Every face a triangle, which `triangulate` would push as it is.
-            triangles = p.indices.as_chunks::<3>().0.to_vec();
-        }
+        // Every face a triangle (`triangulate` would push each as it is), or the faces
+        // triangulated.
+        let mut triangulated = Vec::new();
         let mut start = 0usize;
         for (f, &n) in p.arities.iter().enumerate() {
             let (f, n) = (p.number(f), n as usize);
@@ -141,7 +138,7 @@ impl Builder<'_> {
                 return Err(oerr(p.at(format!("face {f} runs past the index list"))));
             };
             start += n;
-            crate::polygon::triangulate(face, &part.positions, &mut triangles).map_err(|e| {
+            crate::polygon::triangulate(face, positions, &mut triangulated).map_err(|e| {
                 oerr(if p.label.is_empty() {
                     format!("face {f}: {e}")
                 } else {
@@ -149,15 +146,22 @@ impl Builder<'_> {
                 })
             })?;
         }
+        let triangles = match p.arities {
+            [] => p.indices.as_chunks::<3>().0,
+            _ => &triangulated[..],
+        };
+        let mut texcoords = Vec::new();
         if p.texcoords.len() == 2 * nv {
-            for (v, &[u, w]) in p.texcoords.as_chunks::<2>().0.iter().enumerate() {
-                if !(u.is_finite() && w.is_finite()) {
-                    return Err(oerr(
-                        p.at(format!("texture coordinate {} is not finite", p.number(v))),
-                    ));
-                }
-                part.texcoords.push(Vec2::new(u, w));
+            let uv = p.texcoords.as_chunks::<2>().0;
+            if let Some(v) = uv
+                .par_iter()
+                .position_first(|c| !c.iter().all(|x| x.is_finite()))
+            {
+                return Err(oerr(
+                    p.at(format!("texture coordinate {} is not finite", p.number(v))),
+                ));
             }
+            texcoords = uv.par_iter().map(|&[u, w]| Vec2::new(u, w)).collect();
         } else if self
             .albedo_maps
             .get(p.material as usize)
@@ -179,15 +183,50 @@ impl Builder<'_> {
                     .map_or("?", String::as_str)
             ));
         }
-        part.materials = vec![p.material; triangles.len()];
-        part.indices = triangles;
         if desc.normals == NormalMode::Smooth {
-            part.normals = smooth_vertex_normals(&part.positions, &part.indices);
+            normals = smooth_vertex_normals(positions, triangles);
         }
-        if desc.flip_normals {
-            super::shapes::flip(&mut part);
+        let mesh = &mut self.mesh;
+        let (off, flip) = (base as u32, desc.flip_normals);
+        if flip {
+            normals.par_iter_mut().for_each(|n| *n = -*n);
         }
-        self.mesh.append(part);
+        (mesh.indices).par_extend(triangles.par_iter().map(|&[a, b, c]| {
+            let t = if flip { [a, c, b] } else { [a, b, c] };
+            t.map(|i| i + off)
+        }));
+        let count = triangles.len();
+        (mesh.materials).par_extend(rayon::iter::repeat_n(p.material, count));
+        // Per-vertex values stay one per vertex: a part without them gets zeros (as
+        // `TriMesh::append` gives them), and all of them are none while none has any.
+        extend_per_vertex(&mut mesh.normals, normals, base, nv, Vec3::ZERO);
+        extend_per_vertex(&mut mesh.texcoords, texcoords, base, nv, Vec2::ZERO);
         Ok(())
+    }
+}
+
+/// `part`'s per-vertex values (of `n` vertices) after `all`'s (of `before` vertices), where an
+/// empty list stands for `zero` at each of its vertices (left empty while both are).
+fn extend_per_vertex<T: Copy + Send + Sync>(
+    all: &mut Vec<T>,
+    part: Vec<T>,
+    before: usize,
+    n: usize,
+    zero: T,
+) {
+    if all.is_empty() && part.is_empty() {
+        return;
+    }
+    if all.is_empty() {
+        if before == 0 {
+            *all = part;
+            return;
+        }
+        all.resize(before, zero);
+    }
+    if part.is_empty() {
+        all.par_extend(rayon::iter::repeat_n(zero, n));
+    } else {
+        all.par_extend(part);
     }
 }

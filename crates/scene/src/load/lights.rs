@@ -12,6 +12,7 @@ use crate::lights::{
 use crate::texture::Texture;
 use glam::{DVec3, Vec3};
 use math::Frame;
+use rayon::prelude::*;
 
 /// True for a finite point farther out than any vertex may lie.
 fn beyond(p: Vec3) -> bool {
@@ -32,7 +33,16 @@ impl Builder<'_> {
         file: &SceneFile,
     ) -> Result<(Vec<AreaLight>, LightTable), SceneError> {
         let mut lights = Vec::new();
-        for (t, &mat) in self.mesh.materials.iter().enumerate() {
+        // The emitting triangles (and any with an unknown material, for its error below) found
+        // on every core, in order: a large mesh has few.
+        let emits: Vec<bool> = (self.emission.iter())
+            .map(|e| e.max_element() > 0.0 || e.max_element().is_nan())
+            .collect();
+        let found: Vec<(usize, u32)> = (self.mesh.materials.par_iter().enumerate())
+            .filter(|&(_, &mat)| emits.get(mat as usize).copied().unwrap_or(true))
+            .map(|(t, &mat)| (t, mat))
+            .collect();
+        for (t, mat) in found {
             let e = *self.of_material(&self.emission, mat)?;
             if e.max_element() <= 0.0 {
                 continue;

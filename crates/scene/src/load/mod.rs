@@ -341,5 +341,34 @@ pub(crate) fn read_regular(path: &Path) -> std::io::Result<Vec<u8>> {
             "it is {what}, not a regular file"
         )));
     }
+    #[cfg(unix)]
+    if meta.len() >= READ_PIECE as u64 * 2 {
+        return read_pieces(path);
+    }
     std::fs::read(path)
+}
+
+/// Bytes each task of [`read_pieces`] reads.
+const READ_PIECE: usize = 4 << 20;
+
+/// A large file read in pieces on every core: most of a read's time is the kernel copying
+/// into fresh pages, which a single reader leaves to one core. A file whose length changes
+/// meanwhile is read again whole, as `std::fs::read` reads it.
+#[cfg(unix)]
+fn read_pieces(path: &Path) -> std::io::Result<Vec<u8>> {
+    use rayon::prelude::*;
+    use std::os::unix::fs::FileExt;
+    let file = std::fs::File::open(path)?;
+    let len = usize::try_from(file.metadata()?.len()).map_err(std::io::Error::other)?;
+    let mut bytes = vec![0u8; len];
+    let read = bytes
+        .par_chunks_mut(READ_PIECE)
+        .enumerate()
+        .try_for_each(|(i, piece)| file.read_exact_at(piece, (i * READ_PIECE) as u64));
+    match read {
+        Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => std::fs::read(path),
+        Err(e) => Err(e),
+        Ok(()) if file.read_at(&mut [0], len as u64)? != 0 => std::fs::read(path),
+        Ok(()) => Ok(bytes),
+    }
 }

@@ -13,7 +13,6 @@ use super::transform::transform;
 use crate::error::SceneError;
 use crate::file::{EmissionSource, MeshDesc, TfReading};
 use glam::DMat4;
-use std::cell::RefCell;
 use std::collections::HashMap;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
@@ -123,35 +122,24 @@ impl Builder<'_> {
         // tobj asks for MTL files by the name in `mtllib`; read them ourselves so a missing or
         // broken one is reported with its path.
         let obj_dir = obj_path.parent().map(Path::to_path_buf).unwrap_or_default();
-        let mtl_error: RefCell<Option<SceneError>> = RefCell::new(None);
-        let mtl_bytes: RefCell<Vec<u8>> = RefCell::new(Vec::new());
-        let mtl_files: RefCell<Vec<String>> = RefCell::new(Vec::new());
+        let mut mtl_error: Option<SceneError> = None;
+        let mut mtl_bytes: Vec<u8> = Vec::new();
+        let mut mtl_files: Vec<String> = Vec::new();
         // Which MTL file defines which materials: problems name the file at fault.
-        let mtl_of: RefCell<Vec<(PathBuf, Vec<String>)>> = RefCell::new(Vec::new());
-        // Faces come whole and are triangulated here (`polygon`): a fan is wrong for non-convex
-        // faces and makes a hopeless BVH of a huge one. The text is read on every core, and the
-        // bytes go before the models are formed.
-        // The file's hash (one sequential pass) beside the text's parallel reading: a core
-        // that is done with one turns to the other.
-        let hash = &mut *self.hash;
-        let (read, ()) = rayon::join(
-            || objtext::read(&bytes, objtext::CHUNK),
-            || hash.write(&bytes),
-        );
-        drop(bytes);
-        let loaded = objtext::form(read, |p: &Path| {
+        let mut mtl_of: Vec<(PathBuf, Vec<String>)> = Vec::new();
+        let load_mtl = |p: &Path| {
             if !read_mtl {
                 return Ok(Default::default());
             }
             let mtl_path = obj_dir.join(p);
             match read_regular(&mtl_path) {
                 Ok(b) => {
-                    mtl_bytes.borrow_mut().extend_from_slice(&b);
-                    mtl_files.borrow_mut().push(p.display().to_string());
+                    mtl_bytes.extend_from_slice(&b);
+                    mtl_files.push(p.display().to_string());
                     let b = match prescan(&b) {
                         Ok(b) => b,
                         Err(problem) => {
-                            *mtl_error.borrow_mut() = Some(SceneError::new(
+                            mtl_error = Some(SceneError::new(
                                 &mtl_path,
                                 format!("malformed MTL file: {problem} ({of})"),
                             ));
@@ -161,17 +149,17 @@ impl Builder<'_> {
                     tobj::load_mtl_buf(&mut BufReader::new(&b[..]))
                         .inspect(|(mats, _)| {
                             let names = mats.iter().map(|m| m.name.clone()).collect();
-                            mtl_of.borrow_mut().push((mtl_path.clone(), names));
+                            mtl_of.push((mtl_path.clone(), names));
                         })
                         .inspect_err(|e| {
-                            *mtl_error.borrow_mut() = Some(SceneError::new(
+                            mtl_error = Some(SceneError::new(
                                 &mtl_path,
                                 format!("malformed MTL file: {e} ({of})"),
                             ));
                         })
                 }
                 Err(e) => {
-                    *mtl_error.borrow_mut() = Some(SceneError::new(
+                    mtl_error = Some(SceneError::new(
                         &mtl_path,
                         format!(
                             "cannot read MTL file named by `mtllib` in {}: {e} ({of})",
@@ -181,11 +169,22 @@ impl Builder<'_> {
                     Err(tobj::LoadError::OpenFileFailed)
                 }
             }
-        });
-        if let Some(e) = mtl_error.into_inner() {
+        };
+        // Faces come whole and are triangulated here (`polygon`): a fan is wrong for non-convex
+        // faces and makes a hopeless BVH of a huge one. The text is read on every core and its
+        // models formed, beside the file's hash (one sequential pass that needs only the
+        // bytes): a core done with the one turns to the other, and the hash goes on while the
+        // models are formed (one sequential pass too).
+        let hash = &mut *self.hash;
+        let (loaded, ()) = rayon::join(
+            || objtext::form(objtext::read(&bytes, objtext::CHUNK), load_mtl),
+            || hash.write(&bytes),
+        );
+        drop(bytes);
+        if let Some(e) = mtl_error {
             return Err(e);
         }
-        self.hash.write(&mtl_bytes.into_inner());
+        self.hash.write(&mtl_bytes);
         let text = loaded.map_err(|e| oerr(format!("malformed OBJ file: {e}")))?;
         let materials = text
             .materials
@@ -195,8 +194,8 @@ impl Builder<'_> {
             usemtl: text.usemtl,
             lines: text.lines,
             materials,
-            mtl_files: mtl_files.into_inner(),
-            defined_in: mtl_of.into_inner(),
+            mtl_files,
+            defined_in: mtl_of,
         })
     }
 

@@ -185,6 +185,50 @@ fn int(s: &str) -> Option<i64> {
     s.parse::<isize>().ok().map(|x| x as i64)
 }
 
+/// A word of decimal digits with at most one `.` and an optional sign, as `f32::from_str`
+/// reads it, or `None` for anything else (an exponent, `inf`, more digits than below), which
+/// the general path reads. Clinger's fast path: a significand below 2^24 and a power of ten
+/// up to 10^10 are both exact in f32, so their quotient is the correctly rounded value, as
+/// std's (correctly rounding) parser gives it.
+pub(crate) fn decimal(w: &[u8]) -> Option<f32> {
+    let (neg, digits) = match w {
+        [b'-', rest @ ..] => (true, rest),
+        [b'+', rest @ ..] => (false, rest),
+        _ => (false, w),
+    };
+    if digits.is_empty() || digits.len() > 12 {
+        return None;
+    }
+    let (mut m, mut scale, mut dot, mut any) = (0u64, 0usize, false, false);
+    for &c in digits {
+        match c {
+            b'0'..=b'9' => {
+                m = m * 10 + (c - b'0') as u64;
+                scale += dot as usize;
+                any = true;
+            }
+            b'.' if !dot => dot = true,
+            _ => return None,
+        }
+    }
+    const TEN: [f32; 11] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10];
+    let &p = TEN.get(scale)?;
+    if !any || m > 1 << 24 {
+        return None;
+    }
+    let x = m as f32 / p;
+    Some(if neg { -x } else { x })
+}
+
+/// A position index of 1 to 9 digits (no sign, not 0), as [`Chunk::corner`] resolves it.
+fn index(w: &[u8]) -> Option<u32> {
+    if w.is_empty() || w.len() > 9 || !w.iter().all(u8::is_ascii_digit) {
+        return None;
+    }
+    let x = w.iter().fold(0u32, |a, &d| a * 10 + (d - b'0') as u32);
+    x.checked_sub(1)
+}
+
 /// A resolved index as tobj's `usize` (`(count + x) as usize` for negative `x`).
 fn as_index(x: i64) -> u64 {
     x as u64
@@ -253,8 +297,57 @@ impl Chunk {
         true
     }
 
+    /// A plain `v x y z` or `f a b c ...` line (ASCII spaces or tabs between words, simple
+    /// decimals, positive indices, no texture or normal index in the chunk so far) read
+    /// without the general path's word splitting and parsing: most of a large file. `false`
+    /// leaves the chunk as it was, for [`Chunk::line`]'s general reading.
+    fn plain(&mut self, line: &[u8]) -> bool {
+        let blank = |c: &u8| *c == b' ' || *c == b'\t';
+        let (kind, rest) = match line {
+            [k @ (b'v' | b'f'), c, rest @ ..] if blank(c) => (*k, rest),
+            _ => return false,
+        };
+        let mut words = rest.split(blank).filter(|w| !w.is_empty());
+        if kind == b'v' {
+            let mut xyz = [0.0f32; 3];
+            for x in &mut xyz {
+                match words.next().and_then(decimal) {
+                    Some(v) => *x = v,
+                    None => return false,
+                }
+            }
+            if words.next().is_some() {
+                return false;
+            }
+            self.pos.extend_from_slice(&xyz);
+        } else {
+            if !(self.vt.is_empty() && self.vn.is_empty()) {
+                return false;
+            }
+            let before = self.v.len();
+            for w in words {
+                match index(w) {
+                    Some(v) => self.v.push(v),
+                    None => {
+                        self.v.truncate(before);
+                        return false;
+                    }
+                }
+            }
+            if self.v.len() == before {
+                return false;
+            }
+            self.arity.push((self.v.len() - before) as u32);
+        }
+        self.nonblank += 1;
+        true
+    }
+
     /// One line; `Err` stops the chunk.
     fn line(&mut self, n: usize, line: &str) -> Result<(), LoadError> {
+        if self.plain(line.as_bytes()) {
+            return Ok(());
+        }
         let mut w = Words { rest: line };
         let Some(first) = w.next() else {
             return Ok(());
@@ -436,6 +529,7 @@ struct Former<'c> {
     name: String,
     mat: Option<usize>,
     start: At,
+    par: Parallel,
 }
 
 impl Former<'_> {
@@ -452,6 +546,18 @@ impl Former<'_> {
             material_id: self.mat,
             ..ObjModel::default()
         };
+        if let Some((positions, indices, face_arities)) =
+            plain_model(self.chunks, self.start, end, &self.pos, counts, self.par)
+        {
+            self.models.push(ObjModel {
+                positions,
+                indices,
+                face_arities,
+                ..m
+            });
+            self.start = end;
+            return Ok(());
+        }
         // Per new vertex: its texture and normal index and the next vertex of its position.
         let mut extra: Vec<(u64, u64, u32)> = Vec::new();
         let mut used: Vec<u32> = Vec::new();
@@ -579,9 +685,205 @@ impl Former<'_> {
     }
 }
 
+/// The faces of one chunk that a model holds, and the corner its first face starts at.
+struct Span<'c> {
+    c: &'c Chunk,
+    faces: std::ops::Range<usize>,
+    corner: usize,
+}
+
+impl Span<'_> {
+    /// `f(first corner, corners)` of each face the model keeps (points and lines are ignored).
+    fn each(&self, mut f: impl FnMut(usize, usize)) {
+        let mut k = self.corner;
+        for face in self.faces.clone() {
+            let n = self.c.arity.get(face).copied().unwrap_or(0) as usize;
+            if n != 1 && n != 2 {
+                f(k, n);
+            }
+            k += n;
+        }
+    }
+}
+
+/// When [`plain_model`] takes a model, and its task size: tests make both small.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Parallel {
+    /// Corners below which a model is numbered sequentially only (0: every plain model is
+    /// numbered in parallel, however small).
+    pub min_corners: usize,
+    /// Corners per task of the numbering.
+    pub block: usize,
+}
+
+pub(crate) const PARALLEL: Parallel = Parallel {
+    min_corners: 1 << 16,
+    block: 1 << 16,
+};
+
+/// What [`Former::pop`] makes of a large model whose corners carry no texture or normal index
+/// (the file has no colours, every index is in range), on every core: positions, indices and
+/// arities, bit for bit the sequential result, whose vertices are the positions in order of
+/// first use. `None` leaves the model to the sequential path (a small model, one with texture
+/// or normal indices, or one that fails, whose error that path gives).
+fn plain_model(
+    chunks: &[Chunk],
+    start: At,
+    end: At,
+    pos: &[f32],
+    counts: Counts,
+    par: Parallel,
+) -> Option<(Vec<f32>, Vec<u32>, Vec<u32>)> {
+    use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+    if counts.colors > 0 {
+        return None;
+    }
+    let last = end.chunk.min(chunks.len().checked_sub(1)?);
+    let spans: Vec<Span> = (start.chunk..=last)
+        .filter_map(|ci| {
+            let c = chunks.get(ci)?;
+            let first = if ci == start.chunk { start.face } else { 0 };
+            let stop = if ci == end.chunk {
+                end.face
+            } else {
+                c.arity.len()
+            };
+            let corner = if ci == start.chunk { start.corner } else { 0 };
+            (first < stop).then_some(Span {
+                c,
+                faces: first..stop,
+                corner,
+            })
+        })
+        .collect();
+    // Each span's faces as the model keeps them (points and lines are ignored): corners, and
+    // whether all are triangles and all plain.
+    let stats: Vec<(usize, bool, bool)> = spans
+        .par_iter()
+        .map(|s| {
+            let (mut corners, mut triangles, mut plain) = (0, true, true);
+            let missing = |col: &Vec<u64>, r: std::ops::Range<usize>| {
+                col.get(r).is_none_or(|x| x.iter().all(|&t| t == MISSING))
+            };
+            s.each(|k, n| {
+                corners += n;
+                triangles &= n == 3;
+                plain &= missing(&s.c.vt, k..k + n) && missing(&s.c.vn, k..k + n);
+            });
+            (corners, triangles, plain)
+        })
+        .collect();
+    let total: usize = stats.iter().map(|s| s.0).sum();
+    // A model much smaller than the file's positions would spend more on its tables.
+    let small = total < par.min_corners || total < counts.pos / 4;
+    if (small && par.min_corners > 0) || total >= u32::MAX as usize || !stats.iter().all(|s| s.2) {
+        return None;
+    }
+    // The corners' position indices, each span's written by its own task.
+    let mut indices = vec![0u32; total];
+    let mut rest = &mut indices[..];
+    let mut jobs = Vec::with_capacity(spans.len());
+    for (s, st) in spans.iter().zip(&stats) {
+        let (mine, after) = rest.split_at_mut(st.0);
+        jobs.push((s, mine));
+        rest = after;
+    }
+    let in_range = jobs.into_par_iter().all(|(s, out)| {
+        let mut at = out.iter_mut();
+        let mut ok = true;
+        s.each(|k, n| {
+            for i in k..k + n {
+                let v = s.c.v.get(i).copied().unwrap_or(V_MISSING);
+                ok &= v < V_BIG && (v as usize) < counts.pos;
+                if let Some(o) = at.next() {
+                    *o = v;
+                }
+            }
+        });
+        ok
+    });
+    if !in_range {
+        return None;
+    }
+    let arities = if stats.iter().all(|s| s.1) {
+        Vec::new()
+    } else {
+        spans
+            .par_iter()
+            .flat_map_iter(|s| {
+                let mut a = Vec::new();
+                s.each(|_, n| a.push(n as u32));
+                a
+            })
+            .collect()
+    };
+    // Each position's first corner (the least, whichever task sees it first), then the new
+    // vertices of each block counted, numbered from the counts before the block and their
+    // positions copied, then every corner given its position's vertex.
+    let table = || -> Vec<AtomicU32> {
+        (0..counts.pos)
+            .into_par_iter()
+            .map(|_| AtomicU32::new(u32::MAX))
+            .collect()
+    };
+    let first = table();
+    let blocks = || indices.par_chunks(par.block).enumerate();
+    blocks().for_each(|(b, blk)| {
+        for (j, &v) in blk.iter().enumerate() {
+            let i = (b * par.block + j) as u32;
+            if let Some(f) = first.get(v as usize).filter(|f| f.load(Relaxed) > i) {
+                f.fetch_min(i, Relaxed);
+            }
+        }
+    });
+    let is_new = |b: usize, j: usize, v: u32| {
+        first
+            .get(v as usize)
+            .is_some_and(|f| f.load(Relaxed) == (b * par.block + j) as u32)
+    };
+    let news: Vec<usize> = blocks()
+        .map(|(b, blk)| {
+            (blk.iter().enumerate())
+                .filter(|&(j, &v)| is_new(b, j, v))
+                .count()
+        })
+        .collect();
+    let mut positions = vec![0f32; 3 * news.iter().sum::<usize>()];
+    let mut rest = &mut positions[..];
+    let mut outs = Vec::with_capacity(news.len());
+    let mut id = 0u32;
+    for &n in &news {
+        let (mine, after) = rest.split_at_mut(3 * n);
+        outs.push((id, mine));
+        rest = after;
+        id += n as u32;
+    }
+    let ids = table();
+    blocks().zip(outs).for_each(|((b, blk), (mut id, out))| {
+        let mut out = out.as_chunks_mut::<3>().0.iter_mut();
+        for (j, &v) in blk.iter().enumerate() {
+            if !is_new(b, j, v) {
+                continue;
+            }
+            let (Some(slot), Some(o)) = (ids.get(v as usize), out.next()) else {
+                continue;
+            };
+            slot.store(id, Relaxed);
+            let vi = v as usize;
+            o.copy_from_slice(pos.get(3 * vi..3 * vi + 3).unwrap_or(&[0.0; 3]));
+            id += 1;
+        }
+    });
+    indices
+        .par_iter_mut()
+        .for_each(|x| *x = ids.get(*x as usize).map_or(0, |i| i.load(Relaxed)));
+    Some((positions, indices, arities))
+}
+
 /// An OBJ file read in chunks of `chunk` bytes on every core, before its directives are
-/// followed ([`form`]): the file's bytes can go once this is done.
-pub(crate) struct Read(Vec<Chunk>);
+/// followed ([`form`]): the file's bytes can go once this is done. Its [`Parallel`] is
+/// [`PARALLEL`].
+pub(crate) struct Read(Vec<Chunk>, pub(crate) Parallel);
 
 pub(crate) fn read(bytes: &[u8], chunk: usize) -> Read {
     let cuts = cuts(bytes, chunk.max(1));
@@ -592,6 +894,7 @@ pub(crate) fn read(bytes: &[u8], chunk: usize) -> Read {
                 _ => Chunk::default(),
             })
             .collect(),
+        PARALLEL,
     )
 }
 
@@ -602,7 +905,7 @@ pub(crate) fn form(
     read: Read,
     mut load_mtl: impl FnMut(&Path) -> tobj::MTLLoadResult,
 ) -> Result<ObjText, LoadError> {
-    let Read(mut chunks) = read;
+    let Read(mut chunks, par) = read;
     // The counts before each chunk, then its relative indices resolved against them.
     let mut base = Vec::with_capacity(chunks.len());
     let mut total = Counts::default();
@@ -658,6 +961,7 @@ pub(crate) fn form(
         name: "unnamed_object".to_string(),
         mat: None,
         start: At::default(),
+        par,
     };
     let mut mats = Materials::default();
     let mut usemtl: Vec<(usize, String)> = Vec::new();

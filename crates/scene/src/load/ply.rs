@@ -25,6 +25,7 @@ use super::{Builder, read_regular};
 use crate::error::SceneError;
 use crate::file::MeshDesc;
 use glam::DMat4;
+use rayon::prelude::*;
 
 /// What photonflow reads of a PLY file: vertices (with normals and texture coordinates where
 /// the file has them) and polygons, their indices checked against the vertex count.
@@ -40,6 +41,8 @@ pub(crate) struct PlyMesh {
     pub indices: Vec<u32>,
     /// Each face's number of vertices.
     pub arities: Vec<u32>,
+    /// Elements read on every core (tests check that the parallel reading was taken).
+    pub parallel: usize,
 }
 
 impl Builder<'_> {
@@ -58,8 +61,11 @@ impl Builder<'_> {
         let perr = |problem: String| SceneError::new(&path, format!("{problem} ({of})"));
         let bytes = read_regular(&path)
             .map_err(|e| SceneError::new(&path, format!("cannot read PLY file ({of}): {e}")))?;
-        self.hash.write(&bytes);
-        let mesh = parse(&bytes).map_err(|p| perr(format!("malformed PLY file: {p}")))?;
+        // The file's hash (one sequential pass) beside the body's reading.
+        let hash = &mut *self.hash;
+        let (mesh, ()) = rayon::join(|| parse(&bytes), || hash.write(&bytes));
+        drop(bytes);
+        let mesh = mesh.map_err(|p| perr(format!("malformed PLY file: {p}")))?;
         let polygons = Polygons {
             label: "",
             first: 0,
@@ -512,8 +518,18 @@ fn face_list(e: &Element) -> Result<usize, String> {
     }
 }
 
+/// Entries per task of a binary body's parallel reading.
+pub(crate) const BLOCK: usize = 1 << 14;
+
 /// A PLY file's mesh, or the problem with it (one line, without the file's name).
 pub(crate) fn parse(bytes: &[u8]) -> Result<PlyMesh, String> {
+    parse_with(bytes, BLOCK)
+}
+
+/// [`parse`], a binary body's vertices and faces read on every core in tasks of `block`
+/// entries (0: read in order, as an ASCII body always is). The result is the same, bit for
+/// bit; a problem found in parallel is found again in order, so its message is too.
+pub(crate) fn parse_with(bytes: &[u8], block: usize) -> Result<PlyMesh, String> {
     let (format, elements, start) = header(bytes)?;
     let vertex = elements.iter().find(|e| e.name == "vertex");
     let Some(vertex) = vertex else {
@@ -559,11 +575,33 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<PlyMesh, String> {
             ),
             Miss::Bad(what) => format!("element `{}` entry {entry}: {what}", e.name),
         };
+        let par = block > 0 && format != Format::Ascii;
+        if par && e.name == "vertex" && vertices_par(&mut body, e, &roles, &mut mesh, block) {
+            continue;
+        }
+        if par && e.name == "face" && faces_par(&mut body, e, index_list, &mut mesh, block) {
+            continue;
+        }
         for entry in 0..e.count {
             if e.name == "vertex" {
                 read_vertex(&mut body, e, &roles, has_normals, has_uv, &mut mesh)
             } else if e.name == "face" {
-                read_face(&mut body, e, index_list, &mut mesh)
+                let PlyMesh {
+                    indices, arities, ..
+                } = &mut mesh;
+                read_face(
+                    &mut body,
+                    e,
+                    index_list,
+                    &mut |v| {
+                        indices.push(v);
+                        true
+                    },
+                    &mut |a| {
+                        arities.push(a);
+                        true
+                    },
+                )
             } else {
                 e.properties.iter().try_for_each(|p| body.skip(p))
             }
@@ -571,7 +609,11 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<PlyMesh, String> {
         }
     }
     let nv = mesh.positions.len() / 3;
-    if let Some(i) = mesh.indices.iter().position(|&i| i as usize >= nv) {
+    if let Some(i) = mesh
+        .indices
+        .par_iter()
+        .position_first(|&i| i as usize >= nv)
+    {
         let mut start = 0usize;
         let f = mesh
             .arities
@@ -597,6 +639,28 @@ fn read_vertex(
     has_uv: bool,
     mesh: &mut PlyMesh,
 ) -> Result<(), Miss> {
+    let (p, n, uv) = vertex(body, e, roles)?;
+    mesh.positions.extend(p);
+    if has_normals {
+        mesh.normals.extend(n);
+    }
+    if has_uv {
+        mesh.texcoords.extend(turned(uv));
+    }
+    Ok(())
+}
+
+/// Counted down from the image's top, as Mitsuba 3 writes and reads PLY files: OBJ's `vt`
+/// (and the textures here) count up, so `v` turns over.
+fn turned([u, v]: [f64; 2]) -> [f32; 2] {
+    [u as f32, (1.0 - v) as f32]
+}
+
+/// One vertex entry: its position, normal and texture coordinates (zeros where the file has
+/// none).
+type Values = ([f64; 3], [f64; 3], [f64; 2]);
+
+fn vertex(body: &mut Body, e: &Element, roles: &[Role]) -> Result<Values, Miss> {
     let (mut p, mut n, mut uv) = ([0.0f64; 3], [0.0f64; 3], [0.0f64; 2]);
     for (prop, role) in e.properties.iter().zip(roles) {
         let slot = match (*role, prop.kind) {
@@ -610,24 +674,171 @@ fn read_vertex(
             None => body.skip(prop)?,
         }
     }
-    mesh.positions.extend(p);
-    if has_normals {
-        mesh.normals.extend(n);
-    }
-    if has_uv {
-        // Counted down from the image's top, as Mitsuba 3 writes and reads PLY files: OBJ's
-        // `vt` (and the textures here) count up, so `v` turns over.
-        let [u, v] = uv;
-        mesh.texcoords.extend([u as f32, (1.0 - v) as f32]);
-    }
-    Ok(())
+    Ok((p, n, uv))
 }
 
-fn read_face(
+/// A binary `vertex` element of scalars only (every entry the same size) read on every
+/// core, or `false` (nothing read) for the sequential reading.
+fn vertices_par(
+    body: &mut Body,
+    e: &Element,
+    roles: &[Role],
+    mesh: &mut PlyMesh,
+    block: usize,
+) -> bool {
+    let size = e.min_entry(body.format);
+    let scalars = e
+        .properties
+        .iter()
+        .all(|p| matches!(p.kind, Kind::Scalar(_)));
+    let end = body.pos.saturating_add(e.count.saturating_mul(size));
+    let Some(src) = body
+        .bytes
+        .get(body.pos..end)
+        .filter(|_| scalars && size > 0)
+    else {
+        return false;
+    };
+    let (normals, uv) = (mesh.normals.is_empty(), mesh.texcoords.is_empty());
+    if !(mesh.positions.is_empty() && normals && uv) {
+        return false;
+    }
+    let (has_n, has_uv) = (
+        roles.iter().any(|r| matches!(r, Role::Normal(_))),
+        roles.iter().any(|r| matches!(r, Role::Uv(_))),
+    );
+    let n = e.count;
+    let mut p = vec![0.0f64; 3 * n];
+    let mut nor = vec![0.0f64; if has_n { 3 * n } else { 0 }];
+    let mut tex = vec![0.0f32; if has_uv { 2 * n } else { 0 }];
+    let nors = nor.chunks_mut(3 * block).map(Some);
+    let texs = tex.chunks_mut(2 * block).map(Some);
+    let jobs: Vec<_> = src
+        .chunks(size * block)
+        .zip(p.chunks_mut(3 * block))
+        .zip(nors.chain(std::iter::repeat_with(|| None)))
+        .zip(texs.chain(std::iter::repeat_with(|| None)))
+        .collect();
+    let format = body.format;
+    let ok = jobs.into_par_iter().all(|(((src, p), mut nor), mut tex)| {
+        for (k, entry) in src.chunks_exact(size).enumerate() {
+            let mut b = Body {
+                bytes: entry,
+                pos: 0,
+                format,
+                line: 0,
+            };
+            let Ok((pp, nn, uv)) = vertex(&mut b, e, roles) else {
+                return false;
+            };
+            let put = |to: Option<&mut [f64]>, from: &[f64]| {
+                if let Some(to) = to {
+                    to.copy_from_slice(from);
+                }
+            };
+            put(p.get_mut(3 * k..3 * k + 3), &pp);
+            put(
+                nor.as_deref_mut().and_then(|s| s.get_mut(3 * k..3 * k + 3)),
+                &nn,
+            );
+            if let Some(t) = tex.as_deref_mut().and_then(|s| s.get_mut(2 * k..2 * k + 2)) {
+                t.copy_from_slice(&turned(uv));
+            }
+        }
+        true
+    });
+    if ok {
+        (mesh.positions, mesh.normals, mesh.texcoords) = (p, nor, tex);
+        mesh.parallel += 1;
+        body.pos = end;
+    }
+    ok
+}
+
+/// A binary `face` element read on every core: one pass in order finds where each task's
+/// entries start and how many indices they hold, then each task reads its faces into its
+/// part of the lists. `false` (nothing read) leaves the element to the sequential reading,
+/// which also gives any problem's message.
+fn faces_par(
     body: &mut Body,
     e: &Element,
     index_list: usize,
     mesh: &mut PlyMesh,
+    block: usize,
+) -> bool {
+    if !(mesh.indices.is_empty() && mesh.arities.is_empty()) {
+        return false;
+    }
+    let mut scan = Body {
+        bytes: body.bytes,
+        pos: body.pos,
+        format: body.format,
+        line: body.line,
+    };
+    // Per task: its first byte and its number of indices.
+    let mut tasks: Vec<(usize, usize)> = Vec::new();
+    for entry in 0..e.count {
+        if entry % block == 0 {
+            tasks.push((scan.pos, 0));
+        }
+        for (i, prop) in e.properties.iter().enumerate() {
+            let counted = match prop.kind {
+                Kind::List(count, item) if i == index_list => {
+                    let n = scan.list_len(count, item, &prop.name).ok();
+                    let skip = n.unwrap_or(0).saturating_mul(item.size());
+                    scan.pos = scan.pos.saturating_add(skip);
+                    n
+                }
+                _ => scan.skip(prop).ok().map(|()| 0),
+            };
+            match (counted, tasks.last_mut()) {
+                (Some(n), Some(t)) => t.1 += n,
+                _ => return false,
+            }
+        }
+    }
+    let total: usize = tasks.iter().map(|t| t.1).sum();
+    let mut indices = vec![0u32; total];
+    let mut arities = vec![0u32; e.count];
+    let mut jobs = Vec::with_capacity(tasks.len());
+    let (mut rest, mut ar) = (&mut indices[..], &mut arities[..]);
+    for &(start, n) in &tasks {
+        let (mine, after) = rest.split_at_mut(n);
+        let (faces, more) = ar.split_at_mut(block.min(ar.len()));
+        jobs.push((start, mine, faces));
+        (rest, ar) = (after, more);
+    }
+    let format = body.format;
+    let ok = jobs.into_par_iter().all(|(start, idx, faces)| {
+        let mut b = Body {
+            bytes: body.bytes,
+            pos: start,
+            format,
+            line: 0,
+        };
+        let (mut idx, mut faces) = (idx.iter_mut(), faces.iter_mut());
+        (0..faces.len()).all(|_| {
+            let mut index = |v| idx.next().map(|s| *s = v).is_some();
+            let mut arity = |a| faces.next().map(|s| *s = a).is_some();
+            read_face(&mut b, e, index_list, &mut index, &mut arity).is_ok()
+        })
+    });
+    if ok {
+        (mesh.indices, mesh.arities) = (indices, arities);
+        mesh.parallel += 1;
+        body.pos = scan.pos;
+    }
+    ok
+}
+
+/// One face entry, its indices and arity handed to `index` and `arity` (each `false` when it
+/// has no room: an error).
+fn read_face(
+    body: &mut Body,
+    e: &Element,
+    index_list: usize,
+    index: &mut impl FnMut(u32) -> bool,
+    arity: &mut impl FnMut(u32) -> bool,
 ) -> Result<(), Miss> {
     for (i, prop) in e.properties.iter().enumerate() {
         let Kind::List(count, item) = prop.kind else {
@@ -639,7 +850,7 @@ fn read_face(
             continue;
         }
         let n = body.list_len(count, item, &prop.name)?;
-        let arity = u32::try_from(n).map_err(|_| Miss::Bad(format!("a face of {n} vertices")))?;
+        let n_arity = u32::try_from(n).map_err(|_| Miss::Bad(format!("a face of {n} vertices")))?;
         for _ in 0..n {
             let v = match body.read(item)? {
                 Num::Int(v) => v,
@@ -651,9 +862,13 @@ fn read_face(
                     u32::MAX
                 ))
             })?;
-            mesh.indices.push(v);
+            if !index(v) {
+                return Err(Miss::Bad("more indices than counted".to_string()));
+            }
         }
-        mesh.arities.push(arity);
+        if !arity(n_arity) {
+            return Err(Miss::Bad("more faces than counted".to_string()));
+        }
     }
     Ok(())
 }

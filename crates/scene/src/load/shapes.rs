@@ -58,16 +58,6 @@ impl Builder<'_> {
     }
 }
 
-/// Turns every face over: winding reversed, vertex normals negated.
-pub(super) fn flip(part: &mut TriMesh) {
-    for t in &mut part.indices {
-        t.swap(1, 2);
-    }
-    for n in &mut part.normals {
-        *n = -*n;
-    }
-}
-
 /// Mitsuba 3's `cube` mesh (its vertex positions, texture coordinates and faces, as
 /// `mi.traverse` lists them): 24 vertices, 4 per face, two triangles each.
 const CUBE_POSITIONS: [[f32; 3]; 24] = [
@@ -184,13 +174,5 @@ mod tests {
             let nn = (q - p).cross(r - p).normalize();
             assert!((c + nn).length() > c.length(), "face {t:?} faces inwards");
         }
-    }
-
-    #[test]
-    fn flip_turns_faces_over() {
-        let mut m = local(ShapeKind::Rectangle);
-        flip(&mut m);
-        let (_, n) = area_and_normal_sum(&m);
-        assert!((n - DVec3::new(0., 0., -4.)).length() < 1e-6);
     }
 }

@@ -190,3 +190,102 @@ fn non_regular_files_are_refused_without_opening() {
     assert!(err.file.ends_with("a.obj"), "{err}");
     assert!(err.to_string().contains("not a regular file"), "{err}");
 }
+
+/// `threads` rayon threads running `f`.
+fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
+/// A height field of `w` x `h` quads as OBJ text: plain `v` and `f` lines (the quick path),
+/// then a group whose faces carry texture and normal indices, one with quads, one with
+/// relative indices (the general path).
+fn big_obj(w: usize, h: usize) -> String {
+    use std::fmt::Write;
+    let mut s = String::from("mtllib m.mtl\nusemtl white\n");
+    for j in 0..=h {
+        for i in 0..=w {
+            let (x, z) = (i as f64 / w as f64, j as f64 / h as f64);
+            let y = 0.1 * (9.0 * x).sin() * (7.0 * z).cos();
+            let _ = writeln!(s, "v {x:.6} {y:.6} {z:.7}");
+        }
+    }
+    let row = w + 1;
+    for j in 0..h {
+        for i in 0..w {
+            let a = j * row + i + 1;
+            let (b, c, d) = (a + 1, a + row, a + row + 1);
+            let _ = writeln!(s, "f {a} {c} {b}\nf {b}\t{c} {d}");
+        }
+    }
+    s += "vt 0 0\nvt 1 0\nvt 0 1\nvn 0 1 0\ng textured\nf 1/1/1 2/2/1 3/3/1\nf 3/3 2/2 4/1\n";
+    let _ = writeln!(
+        s,
+        "g quads\nusemtl light\nf 1 2 {} {}\nf -1 -2 -3",
+        row + 2,
+        row + 1
+    );
+    s
+}
+
+/// Large files are read in pieces on every core: the same bytes as one sequential read,
+/// on any number of threads, at and around the sizes where the pieces change.
+#[test]
+fn large_files_read_whole_on_any_thread_count() {
+    let piece = 4 << 20;
+    let dir = Scratch::new("pieces", &[]);
+    for len in [2 * piece - 1, 2 * piece, 2 * piece + 1, 3 * piece + 12345] {
+        let bytes: Vec<u8> = (0..len).map(|i| (i * 7 + i / 4093) as u8).collect();
+        let path = dir.path("big.bin");
+        std::fs::write(&path, &bytes).unwrap();
+        for threads in [1, 2, 3] {
+            let got = on_threads(threads, || crate::load::read_regular(&path)).unwrap();
+            assert!(got == bytes, "{len} bytes on {threads} threads");
+        }
+    }
+}
+
+/// A large OBJ (several text chunks, read in pieces) loads to the same mesh, bit for bit,
+/// and the same hashes on 1, 2 and 3 threads.
+#[test]
+fn a_large_obj_loads_the_same_on_any_thread_count() {
+    let obj = big_obj(420, 320);
+    assert!(obj.len() > 9 << 20, "{} bytes", obj.len());
+    let dir = Scratch::new(
+        "bigobj",
+        &[
+            ("s.toml", &scene_toml("a.obj")),
+            ("a.obj", &obj),
+            ("m.mtl", GOOD_MTL),
+        ],
+    );
+    let bits = |v: &[glam::Vec3]| v.iter().map(|p| p.to_array().map(f32::to_bits)).collect();
+    let seen = |threads| {
+        let s = on_threads(threads, || Scene::load(dir.path("s.toml"))).unwrap();
+        let m = s.geometry.mesh();
+        let uv: Vec<[u32; 2]> = m
+            .texcoords
+            .iter()
+            .map(|t| t.to_array().map(f32::to_bits))
+            .collect();
+        let hashes = [s.content_hash, s.photon_hash, s.image_hash, s.view_hash];
+        let positions: Vec<[u32; 3]> = bits(&m.positions);
+        let normals: Vec<[u32; 3]> = bits(&m.normals);
+        (
+            positions,
+            normals,
+            uv,
+            m.indices.clone(),
+            m.materials.clone(),
+            hashes,
+        )
+    };
+    let one = seen(1);
+    assert_eq!(one.3.len(), 2 * 420 * 320 + 2 + 2 + 1);
+    for threads in [2, 3] {
+        assert!(seen(threads) == one, "{threads} threads");
+    }
+}

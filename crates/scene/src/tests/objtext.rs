@@ -47,6 +47,9 @@ const CASES: &[&str] = &[
     "\n\n",
     "f 1 2 3\n",
     "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1\nf 1 2 3\nf 3/1 2 1/1\n",
+    "v -0.999000 +0.212345\t-1.000000\nv 16777216 16777217 .5\nv 5. 0.1234567890123 -0.0\nf 1 2 3\nf\t3  2 1 \n",
+    "v 1 2 3\nv 4 5 6\nv 7 8 9\nf 1 2 -1\nf 1 2 3\nvn 0 0 1\nf 1 2 3\nf 1//1 2//1 3//1\nf 3 2 1\n",
+    "v 1 2 3\nv 4 5 6\nv 7 8 9\nf 1 2 000000003\nf 1 2 0003\nf 1 2 1234567890\nf 1 2 .3\n",
 ];
 
 /// The MTL files the cases name.
@@ -95,7 +98,19 @@ fn by_tobj(bytes: &[u8]) -> Outcome {
 type Directives = (Vec<(usize, String)>, usize);
 
 fn by_objtext(bytes: &[u8], chunk: usize) -> (Outcome, Option<Directives>) {
-    match objtext::form(objtext::read(bytes, chunk), mtl) {
+    by_objtext_with(bytes, chunk, objtext::PARALLEL)
+}
+
+/// [`by_objtext`] with the parallel numbering taking models from `par.min_corners` corners,
+/// in tasks of `par.block`.
+fn by_objtext_with(
+    bytes: &[u8],
+    chunk: usize,
+    par: objtext::Parallel,
+) -> (Outcome, Option<Directives>) {
+    let mut read = objtext::read(bytes, chunk);
+    read.1 = par;
+    match objtext::form(read, mtl) {
         Ok(t) => (
             Ok((
                 t.models,
@@ -151,11 +166,22 @@ fn same(a: &Outcome, b: &Outcome) -> bool {
 
 fn check(bytes: &[u8]) {
     let want = by_tobj(bytes);
-    for chunk in [1, 3, 17, objtext::CHUNK] {
-        let (got, dirs) = by_objtext(bytes, chunk);
+    // Every model numbered in parallel (where it can be), in tasks of 1, 2 and 5 corners.
+    let par = |block| objtext::Parallel {
+        min_corners: 0,
+        block,
+    };
+    for (chunk, par) in [
+        (1, objtext::PARALLEL),
+        (3, par(2)),
+        (17, par(1)),
+        (objtext::CHUNK, objtext::PARALLEL),
+        (objtext::CHUNK, par(5)),
+    ] {
+        let (got, dirs) = by_objtext_with(bytes, chunk, par);
         assert!(
             same(&got, &want),
-            "chunk {chunk}, file {:?}:\n ours {got:?}\n tobj {want:?}",
+            "chunk {chunk}, {par:?}, file {:?}:\n ours {got:?}\n tobj {want:?}",
             String::from_utf8_lossy(bytes)
         );
         if let Some(d) = dirs {
@@ -169,6 +195,73 @@ fn every_case_reads_as_tobj_reads_it() {
     for case in CASES {
         check(case.as_bytes());
     }
+}
+
+/// The quick decimal reading gives std's value, bit for bit, or leaves the word to std.
+#[test]
+fn quick_decimals_are_std_decimals() {
+    let mut words: Vec<String> = [
+        "0",
+        "-0",
+        "+0",
+        "1",
+        "-1.",
+        ".5",
+        "-.5",
+        "5.",
+        ".",
+        "-",
+        "+",
+        "",
+        "1.2.3",
+        "1e3",
+        "inf",
+        "nan",
+        "0x1",
+        "16777216",
+        "16777217",
+        "0.0000000001",
+        "0.00000000001",
+        "123456789012",
+        "1234567890123",
+        "9999999.9",
+        "0.1",
+        "0.3",
+        "3.4028235",
+        "--1",
+        "1-",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    for _ in 0..200_000 {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        let digits = (state % 13) as usize;
+        let dot = (state >> 8) as usize % (digits + 2);
+        let mut w = String::new();
+        if state >> 20 & 1 == 1 {
+            w.push('-');
+        }
+        for i in 0..digits {
+            if i == dot {
+                w.push('.');
+            }
+            w.push(char::from(b'0' + ((state >> (24 + 3 * i)) % 10) as u8));
+        }
+        words.push(w);
+    }
+    let mut quick = 0;
+    for w in &words {
+        if let Some(x) = objtext::decimal(w.as_bytes()) {
+            quick += 1;
+            let std: f32 = w.parse().unwrap_or_else(|_| panic!("{w:?} is no f32"));
+            assert_eq!(x.to_bits(), std.to_bits(), "{w:?}");
+        }
+    }
+    assert!(quick > words.len() / 3, "{quick} of {}", words.len());
 }
 
 /// Mutations of the cases (bytes replaced, inserted, deleted, lines swapped, a token from
@@ -230,4 +323,43 @@ fn a_file_over_many_chunks_reads_as_one() {
         models.iter().map(|m| m.indices.len()).sum::<usize>(),
         2 * 2998 * 3
     );
+}
+
+/// Large plain models (no texture or normal index) numbered in parallel: triangles, quads,
+/// points and lines, faces across chunk boundaries, relative indices, an index out of range;
+/// as tobj reads them, on 1, 2 and 3 threads.
+#[test]
+fn plain_models_numbered_in_parallel_read_as_tobj_reads_them() {
+    let mut s = String::from("mtllib m.mtl\nusemtl red\n");
+    for i in 0..4000 {
+        s += &format!("v {i} {} 0.5\n", i % 7);
+        if i >= 3 {
+            // Faces from the back (first use out of order) and points and lines between.
+            s += &format!("f {} {} {}\nf -1 -3 -2\n", i + 1, i - 2, i);
+            match i % 500 {
+                7 => s += &format!("f {} {} {} {}\np {i}\nl 1 {i}\n", i - 2, i - 1, i, i + 1),
+                11 => s += "g next\nusemtl white\n",
+                _ => {}
+            }
+        }
+    }
+    let bad = s.replacen("f 2000 ", "f 99999 ", 1);
+    assert!(bad != s);
+    for text in [&s, &bad] {
+        let want = by_tobj(text.as_bytes());
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            for block in [1, 7, 1 << 16] {
+                let par = objtext::Parallel {
+                    min_corners: 64,
+                    block,
+                };
+                let (got, _) = pool.install(|| by_objtext_with(text.as_bytes(), 1000, par));
+                assert!(same(&got, &want), "{threads} threads, {par:?}");
+            }
+        }
+    }
 }

@@ -613,3 +613,112 @@ fn xml_ply_shapes_load() {
     assert!(m.positions.iter().all(|p| (p.z - 5.0).abs() <= 0.5 + 1e-6));
     assert_eq!(s.file.meshes[0].ply.as_deref(), Some("cube.ply"));
 }
+
+/// A binary PLY of `n` x `n` vertices (with a skipped property, normals and texture
+/// coordinates) and faces of 3, 4 and 5 corners with a list to read past; `bad` replaces
+/// one face's first index.
+fn grid(format: &'static str, n: usize, bad: Option<(usize, f64)>) -> Vec<u8> {
+    let faces = (n - 2) * (n - 1);
+    let header = format!(
+        "element vertex {}\nproperty float x\nproperty uchar quality\nproperty double y\n\
+         property float z\nproperty float nx\nproperty float ny\nproperty float nz\n\
+         property float u\nproperty float v\n\
+         element face {faces}\nproperty list uchar int vertex_indices\n\
+         property list ushort float extra\n",
+        n * n
+    );
+    let mut w = Writer::new(format, &header);
+    for k in 0..n * n {
+        let (i, j) = ((k % n) as f64, (k / n) as f64);
+        for (ty, x) in [
+            ("float", i / 3.0),
+            ("uchar", 7.0),
+            ("double", (i * j).sin()),
+            ("float", j / 7.0),
+            ("float", 0.0),
+            ("float", 1.0),
+            ("float", 0.0),
+            ("float", i / n as f64),
+            ("float", j / n as f64),
+        ] {
+            w.put(ty, x);
+        }
+    }
+    let mut f = 0;
+    for j in 0..n - 2 {
+        for i in 0..n - 1 {
+            let a = (j * n + i) as f64;
+            let n = n as f64;
+            let mut face = match (i + j) % 3 {
+                0 => vec![a, a + 1.0, a + n],
+                1 => vec![a, a + 1.0, a + n + 1.0, a + n],
+                _ => vec![a, a + 1.0, a + n + 1.0, a + 2.0 * n, a + n],
+            };
+            if let Some((_, v)) = bad.filter(|b| b.0 == f) {
+                face[0] = v;
+            }
+            w.list("uchar", "int", &face);
+            w.list("ushort", "float", &vec![0.5; f % 3]);
+            f += 1;
+        }
+    }
+    w.out
+}
+
+/// A binary body read on every core, in tasks of any size, on 1, 2 and 3 threads, gives the
+/// mesh of the sequential reading bit for bit, and its errors word for word.
+#[test]
+fn binary_bodies_read_in_parallel_as_in_order() {
+    use crate::load::ply::{BLOCK, parse_with};
+    type Bits = (Vec<u64>, Vec<u64>, Vec<u32>, Vec<u32>, Vec<u32>);
+    let bits = |r: &Result<crate::load::ply::PlyMesh, String>| -> Result<Bits, String> {
+        match r {
+            Ok(m) => {
+                let b = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                let t: Vec<u32> = m.texcoords.iter().map(|x| x.to_bits()).collect();
+                let (ix, ar) = (m.indices.clone(), m.arities.clone());
+                Ok((b(&m.positions), b(&m.normals), t, ix, ar))
+            }
+            Err(e) => Err(e.clone()),
+        }
+    };
+    for format in ["binary_little_endian", "binary_big_endian"] {
+        let good = grid(format, 90, None);
+        let late = 90 * 80;
+        let mut cut = good.clone();
+        cut.truncate(good.len() - 100);
+        let files = [
+            good,
+            grid(format, 90, Some((late, -1.0))),
+            grid(format, 90, Some((late, 1e7))),
+            cut,
+        ];
+        for (k, file) in files.iter().enumerate() {
+            let want = parse_with(file, 0);
+            assert_eq!(
+                want.is_ok(),
+                k == 0,
+                "{format} file {k}: {:?}",
+                want.as_ref().err()
+            );
+            for threads in [1, 2, 3] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                for block in [1, 7, 1000, BLOCK] {
+                    let got = pool.install(|| parse_with(file, block));
+                    if let Ok(m) = &got {
+                        assert_eq!(m.parallel, 2, "{format}: vertices and faces in parallel");
+                    }
+                    assert!(
+                        bits(&got) == bits(&want),
+                        "{format} file {k}, {threads} threads, block {block}: {:?} {:?}",
+                        got.as_ref().err(),
+                        want.as_ref().err()
+                    );
+                }
+            }
+        }
+    }
+}
