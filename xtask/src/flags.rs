@@ -154,6 +154,12 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
     let a: Vec<&str> = args.iter().map(String::as_str).collect();
     match a.as_slice() {
         [] | ["help" | "-h" | "--help", ..] => Ok(Cmd::Help),
+        // xtask's own commands and `bench` alone: the help, which lists them.
+        [
+            "gen-scenes" | "slurm-demo" | "fuzz" | "bench",
+            "-h" | "--help",
+            ..,
+        ] => Ok(Cmd::Help),
         ["gen-scenes"] => Ok(Cmd::GenScenes),
         ["slurm-demo"] => Ok(Cmd::SlurmDemo),
         ["fuzz", rest @ ..] => Ok(Cmd::Fuzz(rest.iter().map(|s| s.to_string()).collect())),
@@ -163,6 +169,16 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
                 .map(String::from)
                 .collect(),
         )),
+        // A benchmark's own help: photonflow's, with nothing recorded.
+        ["bench", what, rest @ ..]
+            if BENCHES.contains(what) && rest.iter().any(|s| matches!(*s, "-h" | "--help")) =>
+        {
+            Ok(Cmd::Photonflow(
+                std::iter::once(format!("bench-{what}"))
+                    .chain(rest.iter().map(|s| s.to_string()))
+                    .collect(),
+            ))
+        }
         ["bench", what, rest @ ..] if BENCHES.contains(what) => {
             let mut out = vec![format!("bench-{what}")];
             // The scene benchmarks take a scene first; without one, the worksheet's.
@@ -189,6 +205,14 @@ pub fn parse(args: &[String]) -> Result<Cmd, String> {
                 args: out,
             }))
         }
+        ["bench", rest @ ..] => Err(format!(
+            "bench: {}; name one of {}\n\n{HELP}",
+            rest.first()
+                .map_or("which benchmark?".to_string(), |w| format!(
+                    "`{w}` is not a benchmark"
+                )),
+            BENCHES.join(", ")
+        )),
         [other, ..] => Err(format!("unknown command `{other}`\n\n{HELP}")),
     }
 }

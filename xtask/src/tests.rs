@@ -42,6 +42,26 @@ fn bench_commands_keep_what_was_typed_and_add_the_default_scene() {
     let b = bench(&["bench", "accuracy", "--case", "s.toml,a.exr,b.exr"]);
     assert_eq!(b.args, ["bench-accuracy", "--case", "s.toml,a.exr,b.exr"]);
     assert!(flags::parse(&strings(&["bench", "nope"])).is_err());
+    // A benchmark's help is photonflow's, run plainly: nothing recorded in the docs (it once
+    // replaced the benchmark's section with the help text).
+    for help in ["--help", "-h"] {
+        assert!(matches!(
+            flags::parse(&strings(&["bench", "rays", "--compare", help])),
+            Ok(Cmd::Photonflow(a)) if a == ["bench-rays", "--compare", help]
+        ));
+    }
+    for own in ["fuzz", "gen-scenes", "slurm-demo", "bench"] {
+        assert!(matches!(
+            flags::parse(&strings(&[own, "--help"])),
+            Ok(Cmd::Help)
+        ));
+    }
+    let e = flags::parse(&strings(&["bench"])).err().unwrap_or_default();
+    assert!(e.contains("which benchmark?") && e.contains("rays"), "{e}");
+    let e = flags::parse(&strings(&["bench", "nope"]))
+        .err()
+        .unwrap_or_default();
+    assert!(e.contains("`nope` is not a benchmark"), "{e}");
 }
 
 const DOC: &str = "\
