@@ -1,5 +1,5 @@
 //! Loading: a scene file and every file it names into a [`Scene`]. One room per concern:
-//! `obj.rs` (OBJ meshes, their text read by `objtext.rs` on every core), `ply.rs` (PLY meshes), `faces.rs` (what both share: their
+//! `obj.rs` (OBJ meshes, their text read by `objtext/` on every core), `ply.rs` (PLY meshes), `faces.rs` (what both share: their
 //! polygons checked, transformed, triangulated and appended), `mtl.rs` (the MTL table),
 //! `materials.rs` (scene-file materials, textures, validation), `lights.rs` (emissive
 //! triangles and the scene file's lights), `transform.rs` (the one transform helper),

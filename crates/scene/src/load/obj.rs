@@ -17,7 +17,7 @@ use std::collections::HashMap;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
-/// An OBJ file as `objtext.rs` read it, with what its MTL files told.
+/// An OBJ file as `objtext/` read it, with what its MTL files told.
 struct Parsed {
     models: Vec<ObjModel>,
     materials: Vec<tobj::Material>,

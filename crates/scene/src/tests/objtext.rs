@@ -1,4 +1,4 @@
-//! `crates/scene/src/load/objtext.rs` against tobj 4, the reader it replaced: every model (name, material,
+//! `crates/scene/src/load/objtext/` against tobj 4, the reader it replaced: every model (name, material,
 //! vertices, indices, arities), the materials, the `usemtl` list and the line count, or the
 //! same error, on hand-made files that use each rule and on thousands of mutations of them,
 //! each read whole and in chunks of 1, 3 and 17 bytes (so a chunk boundary falls everywhere).
