@@ -210,7 +210,8 @@ pub fn peer_rate(text: &str, set: &str) -> Option<f64> {
         })
 }
 
-fn median(v: &mut [f64]) -> f64 {
+/// The middle value of `v` (the upper one of an even count), sorting it in place.
+pub(crate) fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
 }

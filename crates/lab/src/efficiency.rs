@@ -32,9 +32,7 @@ impl Runs {
     }
 
     fn median_seconds(&self) -> f64 {
-        let mut s = self.seconds.clone();
-        s.sort_by(f64::total_cmp);
-        s[s.len() / 2]
+        crate::bench::median(&mut self.seconds.clone())
     }
 }
 
