@@ -90,26 +90,19 @@ impl Builder<'_> {
         let nan = Vec3::splat(f32::NAN);
         (mesh.positions).par_extend(corners.par_iter().map(|c| placed(c).unwrap_or(nan)));
         let positions = mesh.positions.get(base..).unwrap_or_default();
-        if positions.par_iter().any(|q| q.x.is_nan()) {
-            for (v, c) in corners.iter().enumerate() {
-                let q = dvec3(c);
-                if !q.is_finite() {
-                    return Err(oerr(p.at(format!(
-                        "vertex {} is not finite ({:?})",
-                        p.number(v),
-                        q.to_array()
-                    ))));
-                }
-                let q = xf.transform_point3(q);
-                if !q.is_finite() || q.abs().max_element() > MAX_COORD {
-                    return Err(oerr(p.at(format!(
-                        "vertex {} lies at {:?} after the mesh's transform, beyond the \
-                     {MAX_COORD:e} scene units photonflow can trace: check the scale",
-                        p.number(v),
-                        q.to_array()
-                    ))));
-                }
-            }
+        // The first vertex that failed, and why.
+        if let Some(v) = positions.par_iter().position_first(|q| q.x.is_nan()) {
+            let q = corners.get(v).map(dvec3).unwrap_or(DVec3::NAN);
+            let why = if q.is_finite() {
+                format!(
+                    "lies at {:?} after the mesh's transform, beyond the {MAX_COORD:e} scene \
+                     units photonflow can trace: check the scale",
+                    xf.transform_point3(q).to_array()
+                )
+            } else {
+                format!("is not finite ({:?})", q.to_array())
+            };
+            return Err(oerr(p.at(format!("vertex {} {why}", p.number(v)))));
         }
         let mut normals = Vec::new();
         if matches!(desc.normals, NormalMode::Auto) && p.normals.len() == 3 * nv {
