@@ -8,12 +8,14 @@
 //! Vectors are `glam`'s; this crate adds what glam lacks.
 
 pub mod analytic;
+mod cache;
 pub mod chi2;
 mod frame;
 mod rng;
 pub mod sampler;
 pub mod warp;
 
+pub use cache::prefetch;
 pub use frame::Frame;
 pub use rng::{Rng, mix64};
 pub use sampler::{Sampler, SobolSampler};

@@ -2,9 +2,7 @@
 //! leaf's density or a hint; depth-first with buffered selection as the fallback), and a
 //! fixed-radius range search.
 
-use super::{
-    Best, KnnHint, Neighbor, Points, dist2, keep_k_smallest, prefetch, radius2, sort_neighbors,
-};
+use super::{Best, KnnHint, Neighbor, Points, dist2, keep_k_smallest, radius2, sort_neighbors};
 use glam::Vec3;
 
 /// Our kd-tree, a bucket tree built in place (Friedman, Bentley, Finkel 1977, "An
@@ -408,10 +406,10 @@ impl KdTree {
     #[inline(always)]
     fn prefetch_leaf(&self, lo: usize, hi: usize) {
         for row in &self.pts.xyz {
-            prefetch(&row[lo..hi]);
+            math::prefetch(&row[lo..hi]);
         }
         if !self.identity {
-            prefetch(&self.ids[lo..hi]);
+            math::prefetch(&self.ids[lo..hi]);
         }
     }
 

@@ -257,31 +257,6 @@ fn sort_bucketed<const B: usize>(out: &mut Vec<Neighbor>, k: usize) {
     }
 }
 
-/// Ask the cache for every line of `s` ahead of reading it: `prefetcht0` on x86_64,
-/// nothing elsewhere. The crate's only `unsafe` code (for `KdTree::prefetch_leaf`).
-#[inline(always)]
-pub(crate) fn prefetch<T>(s: &[T]) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use core::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        let bytes = std::mem::size_of_val(s);
-        let p = s.as_ptr().cast::<i8>();
-        // One address in each 64-byte line `s` touches: every 64th byte from the first,
-        // then the last (the first's line need not start at `s`).
-        let offs = (0..bytes).step_by(64).chain(bytes.checked_sub(1));
-        for off in offs {
-            // SAFETY: a prefetch is a hint: it never faults and changes no memory (Intel
-            // SDM, PREFETCHh), and every address lies inside `s` anyway.
-            #[allow(unsafe_code)]
-            unsafe {
-                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(off))
-            };
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = s;
-}
-
 /// `v` rounded to an integer, for 0 <= v <= 2^22, without a float-to-integer conversion:
 /// v + 2^23 has exponent 23, so its low mantissa bits are v rounded (the usual "magic
 /// number" trick). Monotone like the floor, which is all bucketing needs.
