@@ -1,6 +1,6 @@
 //! Eye subpaths: one per pixel and pass, gathering from every strategy at each vertex.
 
-use crate::light::LightVertex;
+use crate::light::{LightVertex, Merged};
 use crate::surface::Surface;
 use crate::{Grid, Pass, SubPath, mis, weights};
 use bsdf::TransportMode;
@@ -19,7 +19,7 @@ const MAX_SURVIVAL: f32 = 0.95;
 pub struct LightSide<'a> {
     pub vertices: &'a [LightVertex],
     pub starts: &'a [u32],
-    pub grid: Option<&'a Grid>,
+    pub grid: Option<&'a Grid<Merged>>,
 }
 
 /// The eye paths of pixels `range` of `pass`: each pixel's estimate (one path), in order.
@@ -122,7 +122,7 @@ fn pixel(scene: &Scene, pass: &Pass, light: &LightSide, index: u64) -> DVec3 {
                 }
             }
             if let (true, Some(grid)) = (on.merge, light.grid) {
-                sum += beta * merge(pass, &path, &v, light.vertices, grid);
+                sum += beta * merge(pass, &path, &v, grid);
             }
         }
         let Some((wi, s, rev)) = v.surface.sample(u_lobe, u_dir) else {
@@ -264,50 +264,23 @@ fn connect(scene: &Scene, pass: &Pass, path: &SubPath, v: &Vertex, lv: &LightVer
 
 /// The light vertices within the radius merged at the eye vertex with the uniform kernel
 /// (Eq. 47 of the report): photon mapping's density estimate as one more strategy.
-///
-/// The vertices found are fetched in batches: all of a batch prefetched, then merged in the
-/// order found. A pass's vertices span tens of megabytes and each merge's BSDF evaluation
-/// is long enough that the processor would not reach the next vertex's load before the
-/// last one's miss ended; prefetched, the misses overlap (McGuire's Glossy box: the load of
-/// each vertex was 40% of the eye pass's own cycles, `perf`).
-fn merge(pass: &Pass, path: &SubPath, v: &Vertex, vertices: &[LightVertex], grid: &Grid) -> DVec3 {
-    const BATCH: usize = 32;
-    let p = v.hit.point.p;
+fn merge(pass: &Pass, path: &SubPath, v: &Vertex, grid: &Grid<Merged>) -> DVec3 {
     let mut sum = DVec3::ZERO;
-    let mut batch = [0u32; BATCH];
-    let mut n = 0;
-    let mut merge_batch = |batch: &[u32]| {
-        for &i in batch {
-            math::prefetch(vertices.get(i as usize..i as usize + 1).unwrap_or(&[]));
+    grid.query(v.hit.point.p, |lv| {
+        // A light vertex one segment from the light is direct light, which NEE and BSDF
+        // sampling alone weigh at the first non-delta eye vertex.
+        let direct = lv.length == 1 && path.diffuse == 0;
+        if direct || lv.length + path.length > pass.max_len {
+            return;
         }
-        for &i in batch {
-            let Some(lv) = vertices.get(i as usize) else {
-                continue;
-            };
-            // A light vertex one segment from the light is direct light, which NEE and BSDF
-            // sampling alone weigh at the first non-delta eye vertex.
-            let direct = lv.length == 1 && path.diffuse == 0;
-            if direct || lv.length + path.length > pass.max_len {
-                continue;
-            }
-            let Some(e) = v.surface.eval(lv.wo) else {
-                continue;
-            };
-            let w = weights::merge(pass, path.sums(), e.dir, e.rev, lv.sums());
-            let c = (e.f * lv.throughput).as_dvec3() * w as f64;
-            if c.is_finite() {
-                sum += c;
-            }
-        }
-    };
-    grid.query(p, |i| {
-        batch[n] = i as u32;
-        n += 1;
-        if n == BATCH {
-            merge_batch(&batch);
-            n = 0;
+        let Some(e) = v.surface.eval(lv.wo) else {
+            return;
+        };
+        let w = weights::merge(pass, path.sums(), e.dir, e.rev, lv.sums);
+        let c = (e.f * lv.throughput).as_dvec3() * w as f64;
+        if c.is_finite() {
+            sum += c;
         }
     });
-    merge_batch(&batch[..n]);
     sum * pass.vm_norm as f64
 }

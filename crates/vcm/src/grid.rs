@@ -2,34 +2,34 @@
 //! structure SmallVCM and Hachisuka and Jensen 2009 §4.3 use): cells of twice the radius, so
 //! the 2 x 2 x 2 cells nearest a point hold every vertex within the radius of it. Built by a
 //! counting sort, so each bucket lists its vertices in their index order and a query visits
-//! them in an order fixed by the vertices alone. Each bucket also holds its points' positions
-//! in the same order, so a query rejects the candidates beyond the radius (most of them: the
-//! eight cells cover 16 r² of a surface, the disc π r²) without loading their vertices from
-//! a pass's array of many megabytes; on McGuire's Glossy box that load was a cache miss per
-//! candidate and a quarter of the method's cycles (`perf`).
+//! them in an order fixed by the vertices alone.
+//!
+//! Each bucket holds copies of what a query reads, positions and a payload (for merging, the
+//! few fields of a light vertex it needs), side by side in bucket order: a pass's vertices in
+//! path order span tens of megabytes, and loading each candidate from there was a cache miss
+//! apiece and, on McGuire's Glossy box, a quarter of the method's cycles (`perf`).
 
 use glam::Vec3;
 
-pub struct Grid {
+pub struct Grid<T> {
     origin: Vec3,
     inv_cell: f32,
     mask: usize,
-    /// Bucket `b` holds `items[starts[b]..starts[b + 1]]`.
+    /// Bucket `b` holds `points[starts[b]..starts[b + 1]]` and the same range of `data`.
     starts: Vec<u32>,
-    items: Vec<u32>,
-    /// `points[k]` is the position of point `items[k]`.
     points: Vec<Vec3>,
+    data: Vec<T>,
     r2: f32,
 }
 
-impl Grid {
-    /// The grid of `points` for queries of `radius`.
-    pub fn build(points: impl ExactSizeIterator<Item = Vec3> + Clone, radius: f32) -> Grid {
-        let n = points.len();
+impl<T: Copy + Default> Grid<T> {
+    /// The grid of `items` (a position and its payload each) for queries of `radius`.
+    pub fn build(items: impl ExactSizeIterator<Item = (Vec3, T)> + Clone, radius: f32) -> Grid<T> {
+        let n = items.len();
         let buckets = n.max(1).next_power_of_two();
-        let origin = points
+        let origin = items
             .clone()
-            .fold(Vec3::splat(f32::INFINITY), |m, p| m.min(p));
+            .fold(Vec3::splat(f32::INFINITY), |m, (p, _)| m.min(p));
         let origin = if origin.is_finite() {
             origin
         } else {
@@ -40,13 +40,13 @@ impl Grid {
             inv_cell: 0.5 / radius,
             mask: buckets - 1,
             starts: vec![0; buckets + 1],
-            items: vec![0; n],
-            points: vec![Vec3::ZERO; n],
+            points: Vec::new(),
+            data: Vec::new(),
             r2: radius * radius,
         };
-        let cells: Vec<usize> = points
+        let cells: Vec<usize> = items
             .clone()
-            .map(|p| grid.bucket_of(grid.cell(p)))
+            .map(|(p, _)| grid.bucket_of(grid.cell(p)))
             .collect();
         for &b in &cells {
             grid.starts[b + 1] += 1;
@@ -54,11 +54,15 @@ impl Grid {
         for b in 0..buckets {
             grid.starts[b + 1] += grid.starts[b];
         }
-        let mut fill = grid.starts.clone();
-        for (i, (&b, p)) in cells.iter().zip(points).enumerate() {
-            grid.items[fill[b] as usize] = i as u32;
-            grid.points[fill[b] as usize] = p;
-            fill[b] += 1;
+        // Items in bucket order, each bucket in index order.
+        let mut slot: Vec<u32> = grid.starts[..buckets].to_vec();
+        grid.points = vec![Vec3::ZERO; n];
+        grid.data = vec![T::default(); n];
+        for ((p, t), &b) in items.zip(&cells) {
+            let k = slot[b] as usize;
+            grid.points[k] = p;
+            grid.data[k] = t;
+            slot[b] += 1;
         }
         grid
     }
@@ -76,14 +80,14 @@ impl Grid {
         h as usize & self.mask
     }
 
-    /// Calls `f` with the index of every point within the radius of `p`, each once, in an
-    /// order fixed by the points (a hash collision brings other cells' points into a
-    /// bucket, but only those within the radius pass).
+    /// Calls `f` with the payload of every item within the radius of `p`, each once, in an
+    /// order fixed by the items (a hash collision brings other cells' items into a bucket,
+    /// but only those within the radius pass).
     ///
     /// The eight buckets are random places in arrays of megabytes: their bounds, then their
-    /// points and items, are each prefetched for all eight before any is read, so the misses
-    /// overlap (`math::prefetch`; results are the same without).
-    pub fn query(&self, p: Vec3, mut f: impl FnMut(usize)) {
+    /// points and payloads, are each prefetched for all eight before any is read, so the
+    /// misses overlap (`math::prefetch`; results are the same without).
+    pub fn query(&self, p: Vec3, mut f: impl FnMut(&T)) {
         let c = (p - self.origin) * self.inv_cell - Vec3::splat(0.5);
         let base = c.floor();
         let base = [base.x as i32, base.y as i32, base.z as i32];
@@ -96,7 +100,7 @@ impl Grid {
                 base[2] + ((k >> 2) & 1),
             ];
             let b = self.bucket_of(cell);
-            // Two of the eight cells in one bucket would visit its points twice.
+            // Two of the eight cells in one bucket would visit its items twice.
             if !buckets[..n].contains(&b) {
                 buckets[n] = b;
                 n += 1;
@@ -110,20 +114,14 @@ impl Grid {
             });
         for r in &ranges[..n] {
             math::prefetch(&self.points[r.clone()]);
-            math::prefetch(&self.items[r.clone()]);
+            math::prefetch(&self.data[r.clone()]);
         }
         for r in &ranges[..n] {
-            for (&i, &q) in self.items[r.clone()].iter().zip(&self.points[r.clone()]) {
-                if self.within(p, q) {
-                    f(i as usize);
+            for (q, t) in self.points[r.clone()].iter().zip(&self.data[r.clone()]) {
+                if (p - *q).length_squared() <= self.r2 {
+                    f(t);
                 }
             }
         }
-    }
-
-    /// Whether `q` lies within the radius of `p`.
-    #[inline]
-    fn within(&self, p: Vec3, q: Vec3) -> bool {
-        (p - q).length_squared() <= self.r2
     }
 }

@@ -45,7 +45,7 @@ mod weights;
 
 pub use eye::{LightSide, eye_paths};
 pub use grid::Grid;
-pub use light::{CameraSplat, LightVertex, light_paths};
+pub use light::{CameraSplat, LightVertex, Merged, light_paths};
 
 use bsdf::BsdfSample;
 use glam::Vec3;

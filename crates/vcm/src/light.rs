@@ -37,7 +37,29 @@ pub struct CameraSplat {
     pub value: DVec3,
 }
 
+/// What merging reads of a light vertex, kept in the grid beside its position (40 bytes of
+/// the vertex's 136, see [`crate::Grid`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Merged {
+    /// Unit direction back towards the previous vertex.
+    pub wo: Vec3,
+    pub throughput: Vec3,
+    pub length: u32,
+    pub(crate) sums: weights::Sums,
+}
+
 impl LightVertex {
+    /// Its position and what merging reads of it, for [`crate::Grid::build`].
+    pub fn merged(&self) -> (Vec3, Merged) {
+        let m = Merged {
+            wo: self.wo,
+            throughput: self.throughput,
+            length: self.length,
+            sums: self.sums(),
+        };
+        (self.point.p, m)
+    }
+
     /// Its surface, seen from the light's side.
     pub(crate) fn surface(&self) -> Surface {
         Surface::new(

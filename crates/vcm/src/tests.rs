@@ -232,10 +232,10 @@ fn the_grid_finds_every_point_within_the_radius_once() {
         .into_iter()
         .flat_map(|p| [1e-3f32, 0.02, 0.1, 0.5, 3.0].map(|r| (p, r)))
     {
-        let grid = crate::Grid::build(points.iter().copied(), radius);
+        let grid = crate::Grid::build(points.iter().copied().zip(0..points.len()), radius);
         for &q in queries.iter().chain(&points[..6]) {
             let mut found = Vec::new();
-            grid.query(q, |i| found.push(i));
+            grid.query(q, |&i| found.push(i));
             let mut sorted = found.clone();
             sorted.sort_unstable();
             sorted.dedup();

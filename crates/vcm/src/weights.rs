@@ -6,7 +6,7 @@
 use crate::{Pass, mis};
 
 /// A subpath's partial sums at a vertex (on arrival, before it scatters there).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct Sums {
     pub d_vcm: f32,
     pub d_vc: f32,

@@ -126,7 +126,7 @@ impl<'a> Progressive<'a> {
             .opts
             .strategies
             .merge
-            .then(|| vcm::Grid::build(vertices.iter().map(|v| v.point.p), p.radius));
+            .then(|| vcm::Grid::build(vertices.iter().map(|v| v.merged()), p.radius));
         let t1 = std::time::Instant::now();
         let side = vcm::LightSide {
             vertices: &vertices,
