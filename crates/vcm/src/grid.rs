@@ -67,8 +67,11 @@ impl<T: Copy + Default> Grid<T> {
         grid
     }
 
+    /// The cell of an item: `p - origin` is never negative (the origin is the items' least
+    /// corner), so truncation is the floor, without a call to `floorf` (x86-64's baseline has
+    /// no rounding instruction) per coordinate.
     fn cell(&self, p: Vec3) -> [i32; 3] {
-        let c = ((p - self.origin) * self.inv_cell).floor();
+        let c = (p - self.origin) * self.inv_cell;
         [c.x as i32, c.y as i32, c.z as i32]
     }
 
