@@ -18,6 +18,15 @@ use vcm::{CameraSplat, LightVertex};
 /// images the same for any chunking).
 const CHUNK: u64 = 512;
 
+/// A chunk of light subpaths: their vertices, each path's vertex count, their camera splats
+/// and, when merging, what the grid reads of each vertex.
+type LightChunk = (
+    Vec<LightVertex>,
+    Vec<u32>,
+    Vec<CameraSplat>,
+    Vec<(Vec3, vcm::Merged)>,
+);
+
 /// The knobs of the `vcm` crate for this run.
 pub(crate) fn options(run: &Run) -> vcm::Options {
     let s = run.settings;
@@ -114,25 +123,25 @@ impl<'a> Progressive<'a> {
         let mut vertices: Vec<LightVertex> = Vec::with_capacity(self.last_vertices);
         let mut merged: Vec<(Vec3, vcm::Merged)> = Vec::with_capacity(self.last_vertices);
         let mut starts: Vec<u32> = vec![0];
-        flow::run_chunks(p.light_paths, &opts, &light, &mut |(v, c, s, m): (
-            Vec<LightVertex>,
-            Vec<u32>,
-            Vec<CameraSplat>,
-            Vec<(Vec3, vcm::Merged)>,
-        )| {
-            vertices.extend_from_slice(&v);
-            merged.extend_from_slice(&m);
-            for n in c {
-                let last = starts.last().copied().unwrap_or(0);
-                starts.push(last + n);
-            }
-            for splat in s {
-                if let Some(px) = sums.get_mut(splat.pixel as usize) {
-                    *px += splat.value;
+        flow::run_chunks(
+            p.light_paths,
+            &opts,
+            &light,
+            &mut |(v, c, s, m): LightChunk| {
+                vertices.extend_from_slice(&v);
+                merged.extend_from_slice(&m);
+                for n in c {
+                    let last = starts.last().copied().unwrap_or(0);
+                    starts.push(last + n);
                 }
-            }
-            Ok(())
-        })?;
+                for splat in s {
+                    if let Some(px) = sums.get_mut(splat.pixel as usize) {
+                        *px += splat.value;
+                    }
+                }
+                Ok(())
+            },
+        )?;
         if vertices.len() >= u32::MAX as usize {
             return Err(format!(
                 "vcm: {} light vertices in one pass is more than it can index",
