@@ -64,24 +64,32 @@ fn furnace_closed_form(depth: u32) -> f64 {
 /// by its error at that length.
 ///
 /// Measured (six seeds, 16 passes each) from the closed form: 0 bounces exact (emission seen
-/// directly, weight 1), 1 bounce -0.008% ± 0.070%, 2 bounces +0.047% ± 0.079%, 4 bounces
-/// +0.044% ± 0.094%; bound: 4 standard errors plus 0.1% (merging's bias where its disc
+/// directly, weight 1), 1 bounce +0.020% ± 0.018%, 2 bounces +0.064% ± 0.019%, 4 bounces
+/// +0.090% ± 0.034%; bound: 4 standard errors plus 0.1% (merging's bias where its disc
 /// crosses an edge of the box).
+///
+/// The same without bidirectional connections (the default), where a path of `k` bounces has
+/// `k + 3` strategies (emission hit, NEE, light tracing, merging at each eye vertex).
+/// Measured: 1 bounce +0.020% ± 0.018%, 2 bounces +0.086% ± 0.023%, 4 bounces +0.151% ±
+/// 0.027% (merging, weighted more without the connections, brings more of its bias).
 #[test]
 fn the_furnace_reads_its_closed_form_at_every_path_length() {
-    for depth in [0, 1, 2, 4] {
-        let (mean, se) = furnace_mean(depth, "");
-        let want = furnace_closed_form(depth);
-        let rel = mean / want - 1.0;
-        eprintln!(
-            "depth {depth}: {mean:.6} against {want:.6} ({:+.3}% ± {:.3}%)",
-            100.0 * rel,
-            100.0 * se / want
-        );
-        assert!(
-            (mean - want).abs() <= 4.0 * se + 1e-3 * want,
-            "depth {depth}: {mean} against {want} (se {se})"
-        );
+    for bidirectional in [true, false] {
+        for depth in [0, 1, 2, 4] {
+            let (mean, se) = furnace_mean(depth, &format!("bidirectional = {bidirectional}"));
+            let want = furnace_closed_form(depth);
+            let rel = mean / want - 1.0;
+            eprintln!(
+                "bidirectional {bidirectional}, depth {depth}: {mean:.6} against {want:.6} \
+                 ({:+.3}% ± {:.3}%)",
+                100.0 * rel,
+                100.0 * se / want
+            );
+            assert!(
+                (mean - want).abs() <= 4.0 * se + 1e-3 * want,
+                "bidirectional {bidirectional}, depth {depth}: {mean} against {want} (se {se})"
+            );
+        }
     }
 }
 
@@ -92,7 +100,7 @@ fn the_furnace_reads_its_closed_form_at_every_path_length() {
 /// +0.11% ± 0.05% (six seeds; -5.8% without the wrap); bound as above.
 #[test]
 fn fewer_light_paths_than_pixels_still_read_the_closed_form() {
-    let (mean, se) = furnace_mean(4, "light_paths = 64");
+    let (mean, se) = furnace_mean(4, "light_paths = 64\nbidirectional = true");
     let want = furnace_closed_form(4);
     eprintln!(
         "64 light paths: {mean:.6} against {want:.6} ({:+.3}% ± {:.3}%)",
@@ -115,9 +123,12 @@ fn fewer_light_paths_than_pixels_still_read_the_closed_form() {
 #[test]
 fn each_strategy_carries_its_share() {
     let want = furnace_closed_form(4);
-    let all = furnace_means(4, "");
+    let all = furnace_means(4, "bidirectional = true");
     for s in ["hits", "nee", "camera", "connect", "merge"] {
-        let without = furnace_means(4, &format!("strategies = {{ {s} = false }}"));
+        let without = furnace_means(
+            4,
+            &format!("bidirectional = true\nstrategies = {{ {s} = false }}"),
+        );
         let lost: Vec<f64> = all
             .iter()
             .zip(&without)

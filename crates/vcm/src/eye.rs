@@ -44,7 +44,7 @@ fn pixel(scene: &Scene, pass: &Pass, light: &LightSide, index: u64) -> DVec3 {
     let cos = ray.d.normalize().dot(cam.forward());
     // The camera's density per unit solid angle over a pass's pixel samples (`W_e cos`).
     let camera_pdf_w = cam.importance(cos) * cos;
-    let mut path = SubPath::start(mis(pass.light_paths as f32 / camera_pdf_w), 0.0, 0.0);
+    let mut path = SubPath::start(pass, mis(pass.light_paths as f32 / camera_pdf_w), 0.0, 0.0);
     let lights = &scene.light_table;
     let on = pass.opts.strategies;
     let mut sum = DVec3::ZERO;
@@ -113,7 +113,7 @@ fn pixel(scene: &Scene, pass: &Pass, light: &LightSide, index: u64) -> DVec3 {
             if on.nee {
                 sum += beta * nee(scene, pass, &path, &v, u_pick, u_light).as_dvec3();
             }
-            if on.connect {
+            if on.connect && pass.opts.bidirectional {
                 for lv in own {
                     if lv.length + 1 + path.length > pass.max_len {
                         break;

@@ -95,6 +95,12 @@ pub struct Options {
     /// Which strategies contribute. Weights always count all five, so a switched-off
     /// strategy leaves its share of each path out.
     pub strategies: Strategies,
+    /// Whether the method has bidirectional connections at all: eye vertices joined to light
+    /// vertices with at least two vertices on each side. Without them the weights count
+    /// only the strategies left (path tracing's hits and NEE, light tracing, merging), so
+    /// the estimate stays whole, and each eye vertex saves a shadow ray and two BSDF
+    /// evaluations per light vertex of its subpath.
+    pub bidirectional: bool,
 }
 
 /// The power heuristic's `p^2` (Veach 1997 §9.2.4), applied to each density ratio.
@@ -174,20 +180,25 @@ pub(crate) struct SubPath {
     pub d_vcm: f32,
     pub d_vc: f32,
     pub d_vm: f32,
+    /// [`Options::bidirectional`]: whether a connection at a vertex past the subpath's first
+    /// is a strategy.
+    pub bidirectional: bool,
     /// Non-delta bounces made, and whether the last bounce was a delta one.
     pub diffuse: u32,
     pub last_specular: bool,
 }
 
 impl SubPath {
-    /// A subpath leaving its first vertex (the pinhole or the light) with these sums.
-    pub fn start(d_vcm: f32, d_vc: f32, d_vm: f32) -> SubPath {
+    /// A subpath of `pass` leaving its first vertex (the pinhole or the light) with these
+    /// sums.
+    pub fn start(pass: &Pass, d_vcm: f32, d_vc: f32, d_vm: f32) -> SubPath {
         SubPath {
             throughput: Vec3::ONE,
             length: 1,
             d_vcm,
             d_vc,
             d_vm,
+            bidirectional: pass.opts.bidirectional,
             diffuse: 0,
             last_specular: false,
         }
@@ -205,7 +216,17 @@ impl SubPath {
             d_vcm: self.d_vcm,
             d_vc: self.d_vc,
             d_vm: self.d_vm,
+            joins: self.joins(),
         }
+    }
+
+    /// 1 where the vertex the subpath has reached (`length` segments from its start) can be
+    /// the far end of a connection, 0 where that connection would be a bidirectional one
+    /// (two or more vertices on each side) and the pass has none: the factor on `dVCM`
+    /// wherever a weight or a sum counts that connection as a strategy.
+    #[inline]
+    pub fn joins(&self) -> f32 {
+        weights::joins(self.bidirectional, self.length)
     }
 
     /// Arrival at a vertex `dist` away whose cosine to the incoming direction is `cos`: the
@@ -238,8 +259,11 @@ impl SubPath {
         } else {
             self.diffuse += 1;
             let k = mis(cos_out / s.pdf);
-            self.d_vc = k * (self.d_vc * mis(rev_pdf) + self.d_vcm + pass.vm_factor);
-            self.d_vm = k * (self.d_vm * mis(rev_pdf) + self.d_vcm * pass.vc_factor + 1.0);
+            // `dVCM` here stands for the connection that samples this vertex from the other
+            // side (the report's §6.3): a bidirectional one past the first vertex.
+            let d_vcm = self.d_vcm * self.joins();
+            self.d_vc = k * (self.d_vc * mis(rev_pdf) + d_vcm + pass.vm_factor);
+            self.d_vm = k * (self.d_vm * mis(rev_pdf) + d_vcm * pass.vc_factor + 1.0);
             self.d_vcm = mis(1.0 / s.pdf);
         }
         self.throughput *= s.weight();

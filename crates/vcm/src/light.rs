@@ -27,6 +27,8 @@ pub struct LightVertex {
     pub d_vcm: f32,
     pub d_vc: f32,
     pub d_vm: f32,
+    /// [`crate::SubPath::joins`] at the vertex.
+    pub joins: f32,
 }
 
 /// A light vertex's contribution through the camera to pixel `pixel` (already over the
@@ -76,6 +78,7 @@ impl LightVertex {
             d_vcm: self.d_vcm,
             d_vc: self.d_vc,
             d_vm: self.d_vm,
+            joins: self.joins,
         }
     }
 }
@@ -133,7 +136,12 @@ fn trace(
     };
     let mut path = SubPath {
         throughput,
-        ..SubPath::start(mis(pdfs.direct / pdfs.emit), d_vc, d_vc * pass.vc_factor)
+        ..SubPath::start(
+            pass,
+            mis(pdfs.direct / pdfs.emit),
+            d_vc,
+            d_vc * pass.vc_factor,
+        )
     };
     let mut ray: Ray = e.ray;
     loop {
@@ -162,6 +170,7 @@ fn trace(
                 d_vcm: path.d_vcm,
                 d_vc: path.d_vc,
                 d_vm: path.d_vm,
+                joins: path.joins(),
             };
             // A vertex one segment from the light, seen by the camera, is direct light at
             // the first surface seen: NEE and BSDF sampling weigh it alone.

@@ -4,7 +4,9 @@
 //! 2 segments, between NEE and BSDF sampling alone). The weights
 //! are the functions the renderer calls ([`crate::weights`]), fed the partial sums the
 //! subpaths build on their way ([`SubPath::arrive`], [`SubPath::scatter`]) and the densities
-//! at the vertices each strategy joins.
+//! at the vertices each strategy joins. With bidirectional connections switched off
+//! ([`Options::bidirectional`]) the strategies left still sum to one, and the weights of the
+//! full set do not (so the sums really leave the connections out).
 
 use crate::weights;
 use crate::{Options, Pass, Strategies, SubPath, mis};
@@ -92,8 +94,20 @@ enum Light {
     Point,
 }
 
-/// The sum of the weights of every strategy that makes `p`.
+/// The sum of the weights of every strategy of `pass` that makes `p`.
 fn weight_sum(p: &Path, pass: &Pass, light: Light) -> f32 {
+    weight_sum_of(p, pass, light, pass.opts.bidirectional)
+}
+
+/// The sums of `pass` with its connections left out of the total: what switching them off
+/// would give if the weights still counted them.
+fn weight_sum_mixed(p: &Path, pass: &Pass, light: Light) -> f32 {
+    weight_sum_of(p, pass, light, false)
+}
+
+/// The sum of the weights `pass` gives the strategies that make `p`, the bidirectional
+/// connections included only if `connections`.
+fn weight_sum_of(p: &Path, pass: &Pass, light: Light, connections: bool) -> f32 {
     let k = p.x.len() - 1;
     // The light's densities of emitting towards `x[k - 1]` and of NEE choosing its point.
     let (emit, direct, cos_l, delta) = match light {
@@ -105,11 +119,13 @@ fn weight_sum(p: &Path, pass: &Pass, light: Light) -> f32 {
         ),
         Light::Point => (0.25 / PI, 1.0, 1.0, true),
     };
-    let zero = SubPath::start(0.0, 0.0, 0.0).sums();
+    let zero = SubPath::start(pass, 0.0, 0.0, 0.0).sums();
     // The eye subpath's sums on arrival at each vertex.
     let mut eye = vec![zero; k + 1];
-    let mut e = SubPath::start(mis(N as f32 / CAMERA_PDF_W), 0.0, 0.0);
+    let mut e = SubPath::start(pass, mis(pass.light_paths as f32 / CAMERA_PDF_W), 0.0, 0.0);
     for (i, sums) in eye.iter_mut().enumerate().skip(1) {
+        // Segments from the pinhole, as the eye pass counts them at vertex `i`.
+        e.length = i as u32;
         e.arrive(p.dist2(i - 1, i), p.cos(i, i - 1), true);
         *sums = e.sums();
         if i < k {
@@ -123,8 +139,9 @@ fn weight_sum(p: &Path, pass: &Pass, light: Light) -> f32 {
     // The light subpath's, from `x[k]` back to `x[1]`.
     let mut lights = vec![zero; k + 1];
     let d_vc = if delta { 0.0 } else { mis(cos_l / emit) };
-    let mut l = SubPath::start(mis(direct / emit), d_vc, d_vc * pass.vc_factor);
+    let mut l = SubPath::start(pass, mis(direct / emit), d_vc, d_vc * pass.vc_factor);
     for j in (1..k).rev() {
+        l.length = (k - j) as u32;
         l.arrive(p.dist2(j + 1, j), p.cos(j, j + 1), true);
         lights[j] = l.sums();
         if j > 1 {
@@ -156,8 +173,8 @@ fn weight_sum(p: &Path, pass: &Pass, light: Light) -> f32 {
         cos_l,
         first,
     );
-    // Connections `x[i]` to `x[i + 1]`.
-    for i in 1..k - 1 {
+    // Connections `x[i]` to `x[i + 1]`, where the pass has them.
+    for i in (1..k - 1).filter(|_| connections) {
         let d2 = p.dist2(i, i + 1);
         sum += weights::connect(
             pass,
@@ -182,35 +199,92 @@ fn weight_sum(p: &Path, pass: &Pass, light: Light) -> f32 {
     sum
 }
 
-#[test]
-fn the_weights_of_every_strategy_sum_to_one() {
+/// The weight sums of 50 random paths of each length and light, at each radius, for a
+/// 256 x 256 image's light paths and for one (where light tracing no longer outweighs the
+/// connections), with or without bidirectional connections; the largest |sum - 1|.
+fn worst_sum(bidirectional: bool) -> f32 {
     let mut rng = Rng::for_index(7, 0);
     let mut worst = 0.0f32;
-    for radius in [1e-4, 1e-3, 3e-3, 0.01, 0.03, 0.1, 0.3, 1.0] {
+    let cases = [1e-4, 1e-3, 3e-3, 0.01, 0.03, 0.1, 0.3, 1.0]
+        .into_iter()
+        .flat_map(|r| [(r, N), (r, 1)]);
+    for (radius, light_paths) in cases {
         let opts = Options {
             max_depth: 64,
             rr_depth: 64,
-            light_paths: N,
+            light_paths,
             radius,
             alpha: 0.75,
             strategies: Strategies::ALL,
+            bidirectional,
         };
-        let pass = Pass::with(1, N, opts, 0);
+        let pass = Pass::with(1, light_paths, opts, 0);
         for k in 2..=8 {
             for light in [Light::Area(0.5), Light::Point] {
                 for _ in 0..50 {
                     let p = random_path(&mut rng, k);
                     let s = weight_sum(&p, &pass, light);
                     worst = worst.max((s - 1.0).abs());
-                    assert!(
-                        (s - 1.0).abs() < 1e-4,
-                        "radius {radius}, {k} segments: the weights sum to {s}"
-                    );
                 }
             }
         }
     }
-    eprintln!("worst |sum - 1| over 5600 paths: {worst:.2e}");
+    worst
+}
+
+#[test]
+fn the_weights_of_every_strategy_sum_to_one() {
+    // Measured: 1.2e-6 with connections, 1.2e-6 without (f32 rounding).
+    for bidirectional in [true, false] {
+        let worst = worst_sum(bidirectional);
+        eprintln!("bidirectional {bidirectional}: worst |sum - 1| over 11200 paths: {worst:.2e}");
+        assert!(
+            worst < 1e-4,
+            "bidirectional {bidirectional}: a sum is {worst} off one"
+        );
+    }
+}
+
+/// Without bidirectional connections, weights that still counted them (the sums built as
+/// with them) would leave the connections' share out: the test above sees the difference.
+/// One light path per pass and a tiny radius, so that neither light tracing (its weight
+/// grows with the light paths) nor merging leaves the connections a negligible share.
+#[test]
+fn weights_without_connections_leave_them_out_of_the_sums() {
+    let mut rng = Rng::for_index(3, 0);
+    let opts = Options {
+        max_depth: 64,
+        rr_depth: 64,
+        light_paths: 1,
+        radius: 1e-4,
+        alpha: 0.75,
+        strategies: Strategies::ALL,
+        bidirectional: true,
+    };
+    let with = Pass::with(1, 1, opts, 0);
+    let without = Pass::with(
+        1,
+        1,
+        Options {
+            bidirectional: false,
+            ..opts
+        },
+        0,
+    );
+    // Paths of 4 segments and more have bidirectional connections; with them counted in
+    // the sums but not made, a path's weights fall short of one.
+    let (mut short, mut lowest) = (0, 1.0f32);
+    for _ in 0..200 {
+        let p = random_path(&mut rng, 5);
+        let full = weight_sum(&p, &with, Light::Area(0.5));
+        let left = weight_sum(&p, &without, Light::Area(0.5));
+        assert!((full - 1.0).abs() < 1e-4 && (left - 1.0).abs() < 1e-4);
+        let mixed = weight_sum_mixed(&p, &with, Light::Area(0.5));
+        short += (mixed < 1.0 - 1e-3) as u32;
+        lowest = lowest.min(mixed);
+    }
+    eprintln!("{short} of 200 paths short of one by more than 1e-3, the lowest {lowest}");
+    assert!(short > 150, "only {short} of 200 paths missed a share");
 }
 
 /// The grid's query visits exactly the points a brute-force scan finds within the radius,

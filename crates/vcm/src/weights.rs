@@ -11,6 +11,21 @@ pub(crate) struct Sums {
     pub d_vcm: f32,
     pub d_vc: f32,
     pub d_vm: f32,
+    /// [`joins`] at the vertex: the factor on `d_vcm` where it stands for a connection.
+    pub joins: f32,
+}
+
+/// 1 where a subpath `length` segments long (its vertex `length`) can be the far end of a
+/// connection, 0 where that would be a bidirectional connection and `bidirectional` is off.
+/// At a subpath's first vertex the connection that samples it from the other side is next-
+/// event estimation (light side) or light tracing (eye side): always strategies.
+#[inline]
+pub(crate) fn joins(bidirectional: bool, length: u32) -> f32 {
+    if bidirectional || length <= 1 {
+        1.0
+    } else {
+        0.0
+    }
 }
 
 /// Emission an eye path hits, against every strategy that reaches the light from its side:
@@ -50,7 +65,7 @@ pub(crate) fn nee(
         return 1.0 / (w_light + 1.0);
     }
     let w_camera = mis(emit * cos_eye / (direct_w * cos_light))
-        * (pass.vm_factor + eye.d_vcm + eye.d_vc * mis(bsdf_rev));
+        * (pass.vm_factor + eye.joins * eye.d_vcm + eye.d_vc * mis(bsdf_rev));
     1.0 / (w_light + 1.0 + w_camera)
 }
 
@@ -75,8 +90,8 @@ pub(crate) fn connect(
 /// vertex's incoming direction (`eye_dir`) and the reverse (`eye_rev`).
 #[inline]
 pub(crate) fn merge(pass: &Pass, eye: Sums, eye_dir: f32, eye_rev: f32, light: Sums) -> f32 {
-    let w_light = light.d_vcm * pass.vc_factor + light.d_vm * mis(eye_dir);
-    let w_camera = eye.d_vcm * pass.vc_factor + eye.d_vm * mis(eye_rev);
+    let w_light = light.joins * light.d_vcm * pass.vc_factor + light.d_vm * mis(eye_dir);
+    let w_camera = eye.joins * eye.d_vcm * pass.vc_factor + eye.d_vm * mis(eye_rev);
     1.0 / (w_light + 1.0 + w_camera)
 }
 
@@ -86,6 +101,6 @@ pub(crate) fn merge(pass: &Pass, eye: Sums, eye_dir: f32, eye_rev: f32, light: S
 #[inline]
 pub(crate) fn camera(pass: &Pass, light: Sums, camera_pdf_a: f32, rev: f32) -> f32 {
     let w_light = mis(camera_pdf_a / pass.light_paths as f32)
-        * (pass.vm_factor + light.d_vcm + light.d_vc * mis(rev));
+        * (pass.vm_factor + light.joins * light.d_vcm + light.d_vc * mis(rev));
     1.0 / (1.0 + w_light)
 }

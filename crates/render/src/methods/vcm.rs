@@ -48,6 +48,7 @@ pub(crate) fn options(run: &Run) -> vcm::Options {
             connect: v.strategies.connect,
             merge: v.strategies.merge,
         },
+        bidirectional: v.bidirectional,
     }
 }
 
