@@ -119,9 +119,17 @@ impl<'a> Progressive<'a> {
             } else {
                 Vec::new()
             };
+            // Only bidirectional connections read whole vertices: without them a pass keeps
+            // what merging reads and the counts, and never copies the vertices together.
+            if !p.opts.bidirectional {
+                v = Vec::new();
+            }
             (v, c, s, m)
         };
-        let mut vertices: Vec<LightVertex> = Vec::with_capacity(self.last_vertices);
+        let mut vertices: Vec<LightVertex> = Vec::new();
+        if self.opts.bidirectional {
+            vertices.reserve(self.last_vertices);
+        }
         let mut merged: Vec<(Vec3, vcm::Merged)> = Vec::with_capacity(self.last_vertices);
         let mut starts: Vec<u32> = vec![0];
         flow::run_chunks(
@@ -133,7 +141,7 @@ impl<'a> Progressive<'a> {
                 merged.extend_from_slice(&m);
                 for n in c {
                     let last = starts.last().copied().unwrap_or(0);
-                    starts.push(last + n);
+                    starts.push(last.saturating_add(n));
                 }
                 for splat in s {
                     if let Some(px) = sums.get_mut(splat.pixel as usize) {
@@ -143,16 +151,16 @@ impl<'a> Progressive<'a> {
                 Ok(())
             },
         )?;
-        if vertices.len() >= u32::MAX as usize {
+        let made = starts.last().copied().unwrap_or(0) as usize;
+        if made >= u32::MAX as usize {
             return Err(format!(
-                "vcm: {} light vertices in one pass is more than it can index",
-                vertices.len()
+                "vcm: {made} light vertices in one pass is more than it can index"
             ));
         }
         // No grid when merging is switched off: nothing would query it.
         let grid = merge.then(|| vcm::Grid::build(merged.iter().copied(), p.radius));
         drop(merged);
-        self.last_vertices = vertices.len() + vertices.len() / 8;
+        self.last_vertices = made + made / 8;
         let t1 = std::time::Instant::now();
         let side = vcm::LightSide {
             vertices: &vertices,
@@ -175,7 +183,7 @@ impl<'a> Progressive<'a> {
             progress(n);
             Ok(())
         })?;
-        self.light_vertices += vertices.len() as u64;
+        self.light_vertices += made as u64;
         self.t_light += (t1 - t0).as_secs_f64();
         self.t_eye += t1.elapsed().as_secs_f64();
         Ok(sums)
