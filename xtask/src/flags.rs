@@ -13,7 +13,7 @@ cargo xtask <command>   (the photonflow commands build the `photonflow` binary w
                       the photon methods chain trace (or reuse the cache) -> estimate -> composite;
                       sppm, light, vcm and the splatting methods run in passes (--passes, --time) and
                       write snapshots at 1, 2, 4, ... passes;
-                      without --method: the scene's render.method (default sppm)
+                      without --method: the scene's render.method (default vcm)
   trace SCENE [--photons N] [--cache DIR] [--threads N] [--force]
                       trace the photon sets the scene's effects plan asks for into the cache,
                       or reuse them when the scene and parameters are unchanged

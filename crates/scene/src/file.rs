@@ -190,16 +190,17 @@ pub enum Method {
     #[serde(rename = "path+splat")]
     PathSplat,
     /// Stochastic progressive photon mapping (Hachisuka and Jensen 2009): visible points per
-    /// pixel, photons in passes, radii shrinking per pixel; consistent. The default: on the
-    /// worksheet scene it reaches a given error first (`cargo xtask bench accuracy`).
-    #[default]
+    /// pixel, photons in passes, radii shrinking per pixel; consistent.
     Sppm,
     /// Light tracing: light paths connected to the camera at every non-delta vertex
     /// (`[estimate.light]`); sharp caustics without a density estimate.
     Light,
     /// Vertex connection and merging (Georgiev et al. 2012): path tracing, next-event
-    /// estimation, light tracing, bidirectional connections and merging, weighted per path
-    /// by MIS (`[estimate.vcm]`).
+    /// estimation, light tracing, merging (and, on request, bidirectional connections),
+    /// weighted per path by MIS (`[estimate.vcm]`). The default: it reaches a given error
+    /// first on the worksheet box and McGuire's boxes at every budget of `cargo xtask bench
+    /// accuracy` (docs/benchmarks.md).
+    #[default]
     Vcm,
 }
 

@@ -26,10 +26,11 @@ use std::path::PathBuf;
 /// and pass (so it refuses --spp), and its per-pixel radii shrink so that its error goes
 /// to zero.
 ///
-/// Why sppm is the default: on the worksheet scene it has 6.7 to 8.4 times less error than
-/// the best peer (SmallVCM's progressive photon mapping; Mitsuba 3, LuxCore, Cycles and
-/// SmallVCM's bidirectional methods further behind) at budgets of 2, 5, 15 and 60 s, and
-/// reaches that peer's 60-s error in 4.6 s (bench-accuracy, docs/benchmarks.md).
+/// Why vcm is the default: at 128 x 128 it has 0.38-0.79x sppm's error on the worksheet box,
+/// 0.21-0.25x on McGuire's Original and 0.07-0.09x on its Glossy box at budgets of 2, 5, 15
+/// and 60 s, and draws sharp caustics from point and spot lights without a density
+/// estimate's blur; sppm in turn has 6.7 to 8.4 times less error than the best peer on the
+/// worksheet (bench-accuracy, docs/benchmarks.md).
 #[derive(clap::Args)]
 pub(crate) struct Render {
     /// The scene file (TOML).
