@@ -23,8 +23,12 @@
 #
 #   mitsuba       path tracer (llvm_ad_rgb, independent sampler, box filter, no depth limit,
 #                 Russian roulette from depth 5). It has no time limit: the spp come from a
-#                 calibration (two short untimed renders, 4 and 32 spp, cached per scene file
-#                 and size) fitting wall = start-up + spp x seconds per spp, to fill SECONDS.
+#                 calibration (two short untimed renders, 16 and 64 spp, one and four passes of
+#                 16, cached per scene file and size) fitting wall = start-up + spp x seconds
+#                 per spp, to fill SECONDS. (4 and 32 spp, a pass of 4 against two of 16,
+#                 measured the compilation of two kernels more than the passes: on McGuire's
+#                 Glossy box at 128 x 128 they predicted under 1 ms per spp where long runs
+#                 took 4.5, and runs overshot their budgets fourfold.)
 #   mitsuba-ptracer  Mitsuba 3's particle (light) tracer, calibrated the same way: it draws
 #                 no specular surface the camera sees (as photonflow's `light`).
 #   luxcore      path tracer + PhotonGI caustic cache (100k photons a second of SECONDS, 100k
@@ -84,11 +88,11 @@ case $peer in
     cache=${PEER_CACHE:-$(dirname "$out")/peer-cache}
     mkdir -p "$cache"
     key=$(cat "$scene" "$TMP/camera.json" | cksum | cut -d' ' -f1)
-    cal=$cache/$peer-$key-${W}x$H.txt
+    cal=$cache/$peer-cal16-64-$key-${W}x$H.txt
     if [ ! -s "$cal" ]; then
       t() { local t0; t0=$(date +%s.%N); mi "$1" "$TMP/cal.exr"; echo "$(date +%s.%N) $t0" | awk '{ print $1 - $2 }'; }
-      t4=$(t 4) t32=$(t 32)
-      echo "$t4 $t32" | awk '{b = ($2 - $1) / 28; if (b <= 1e-3) b = 1e-3; a = $1 - 4 * b; if (a < 0) a = 0; print a, b}' > "$cal"
+      t16=$(t 16) t64=$(t 64)
+      echo "$t16 $t64" | awk '{b = ($2 - $1) / 48; if (b <= 1e-5) b = 1e-5; a = $1 - 16 * b; if (a < 0) a = 0; print a, b}' > "$cal"
     fi
     read -r a b < "$cal"
     spp=$(awk -v s="$secs" -v a="$a" -v b="$b" 'BEGIN { n = int((s - a) / b); print (n < 1 ? 1 : n) }')
