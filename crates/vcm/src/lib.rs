@@ -29,7 +29,7 @@
 //! (the paper's technical report, §6.3; SmallVCM's `vertexcm.hxx` spells them out), so a
 //! weight costs a few products whatever the path's length. Without bidirectional
 //! connections, the `dVCM` terms that stand for them are left out of the sums and weights
-//! ([`weights::joins`]), so the strategies left still sum to one. They leave out Russian roulette
+//! (`weights::joins`), so the strategies left still sum to one. They leave out Russian roulette
 //! (it changes how often a strategy runs, not which paths it can make), so they still sum to
 //! one over the strategies: the estimate is unbiased but for merging's own bias.
 //!

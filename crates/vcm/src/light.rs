@@ -27,7 +27,8 @@ pub struct LightVertex {
     pub d_vcm: f32,
     pub d_vc: f32,
     pub d_vm: f32,
-    /// [`crate::SubPath::joins`] at the vertex.
+    /// `SubPath::joins` at the vertex: 0 where a connection ending here is a bidirectional
+    /// one and the pass has none, else 1.
     pub joins: f32,
 }
 
