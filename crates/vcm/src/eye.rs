@@ -266,6 +266,7 @@ fn connect(scene: &Scene, pass: &Pass, path: &SubPath, v: &Vertex, lv: &LightVer
 /// (Eq. 47 of the report): photon mapping's density estimate as one more strategy.
 fn merge(pass: &Pass, path: &SubPath, v: &Vertex, grid: &Grid<Merged>) -> DVec3 {
     let mut sum = DVec3::ZERO;
+    let eye = path.sums();
     grid.query(v.hit.point.p, |lv| {
         // A light vertex one segment from the light is direct light, which NEE and BSDF
         // sampling alone weigh at the first non-delta eye vertex.
@@ -276,7 +277,7 @@ fn merge(pass: &Pass, path: &SubPath, v: &Vertex, grid: &Grid<Merged>) -> DVec3 
         let Some(e) = v.surface.eval(lv.wo) else {
             return;
         };
-        let w = weights::merge(pass, path.sums(), e.dir, e.rev, lv.sums);
+        let w = weights::merge(pass, eye, e.dir, e.rev, lv.sums);
         let c = (e.f * lv.throughput).as_dvec3() * w as f64;
         if c.is_finite() {
             sum += c;

@@ -130,7 +130,10 @@ impl<'a> Progressive<'a> {
         if self.opts.bidirectional {
             vertices.reserve(self.last_vertices);
         }
-        let mut merged: Vec<(Vec3, vcm::Merged)> = Vec::with_capacity(self.last_vertices);
+        let mut merged: Vec<(Vec3, vcm::Merged)> = Vec::new();
+        if merge {
+            merged.reserve(self.last_vertices);
+        }
         let mut starts: Vec<u32> = vec![0];
         flow::run_chunks(
             p.light_paths,
